@@ -1,0 +1,8 @@
+"""spacepol: probabilistic inversion of polarimetric reflectance.
+
+Physics lives in :mod:`spacepol.physics` (forward pBRDF model built from effects),
+measurements in :mod:`spacepol.io`, inference in :mod:`spacepol.infer`, reporting in
+:mod:`spacepol.report`.  The command line is :mod:`spacepol.cli` (``invert-mcmc``).
+"""
+
+__version__ = "0.1.0"

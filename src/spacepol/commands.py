@@ -1,0 +1,133 @@
+"""What each ``invert-mcmc`` subcommand does.  Each takes the parsed arguments, returns an exit code."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError, SpacepolError
+from .io import Dataset, read_measurements, write_table
+from .physics.geometry import Geometry, default_grid
+from .physics.model import Model, build_model
+
+
+def parse_settings(items, model: Model) -> dict[str, float]:
+    """``["n=1.5", "k=0"]`` -> {"n": 1.5, "k": 0.0}, checked against the model."""
+    values = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ParameterError(f"--set '{item}': expected NAME=VALUE")
+        param = model.parameter(name)
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParameterError(f"--set '{item}': '{text}' is not a number") from None
+        param.check(value, where="--set")
+        values[name] = value
+    return values
+
+
+def _prediction_columns(geometry: Geometry, prediction) -> dict:
+    s = prediction.stokes
+    return {
+        "theta_i": geometry.theta_i, "theta_r": geometry.theta_r, "dphi": geometry.dphi,
+        "s0": s[0], "s1": s[1], "s2": s[2], "s3": s[3],
+        "dop": prediction.dop, "aop": prediction.aop_deg, "brdf": prediction.brdf,
+    }
+
+
+def forward(args) -> int:
+    model = build_model(args.model)
+    values = parse_settings(args.set, model)
+    data = read_measurements(args.geometry, require_observable=False)
+    prediction = model.evaluate(values, data.geometry)
+    columns = _prediction_columns(data.geometry, prediction)
+    if data.wavelength_um is not None:
+        columns["wavelength_um"] = data.wavelength_um
+    meta = {"model": model.name, **{f"param_{k}": v for k, v in {**model.defaults(), **values}.items()}}
+    write_table(args.out, columns, meta)
+    print(f"wrote {args.out}: {len(data)} geometries, model {model.name}")
+    return 0
+
+
+def synth(args) -> int:
+    model = build_model(args.model)
+    values = {**model.defaults(), **parse_settings(args.set, model)}
+    if args.noise_dop < 0 or (args.noise_brdf is not None and args.noise_brdf < 0):
+        raise ParameterError("noise levels must be >= 0")
+    if args.geometry:
+        geo_data = read_measurements(args.geometry, require_observable=False)
+        geometry = geo_data.geometry
+        wavelength = geo_data.wavelength_um
+    else:
+        geometry = default_grid()
+        wavelength = None
+    if args.wavelength_um is not None:
+        wavelength = np.full(geometry.size, args.wavelength_um)
+    if wavelength is not None:
+        geometry = Geometry(geometry.theta_i, geometry.theta_r, geometry.dphi, wavelength)
+    rng = np.random.default_rng(args.seed)
+    prediction = model.evaluate(values, geometry)
+    dop = np.clip(prediction.dop + rng.normal(0.0, args.noise_dop, geometry.size), 0.0, 1.0)
+    columns = {"theta_i": geometry.theta_i, "theta_r": geometry.theta_r, "dphi": geometry.dphi, "dop": dop}
+    if args.noise_dop > 0:
+        columns["dop_err"] = np.full(geometry.size, args.noise_dop)
+    if args.noise_brdf is not None:
+        brdf = prediction.brdf * (1.0 + rng.normal(0.0, args.noise_brdf, geometry.size))
+        columns["brdf"] = np.maximum(brdf, 0.0)
+        if args.noise_brdf > 0:
+            columns["brdf_err"] = args.noise_brdf * prediction.brdf
+    if wavelength is not None:
+        columns["wavelength_um"] = wavelength
+    meta = {
+        "source": "spacepol synth",
+        "model": model.name,
+        "seed": args.seed,
+        "noise_dop": args.noise_dop,
+        **{f"truth_{k}": v for k, v in values.items()},
+    }
+    write_table(args.out, columns, meta)
+    print(f"wrote {args.out}: {geometry.size} points from {model.name} (seed {args.seed})")
+    return 0
+
+
+def effects(args) -> int:
+    from .physics.effects import PRESETS, registry
+    import textwrap
+
+    for name in registry.names():
+        cls = registry.get(name)
+        print(f"{name}")
+        print(textwrap.fill(cls.description, width=96, initial_indent="    ", subsequent_indent="    "))
+        for p in cls.parameters:
+            print(f"    - {p.describe()}")
+        extras = []
+        if cls.requires:
+            extras.append("needs " + ", ".join(cls.requires))
+        if cls.excludes:
+            extras.append("replaces " + ", ".join(cls.excludes))
+        if cls.removes:
+            extras.append("replaces parameter " + ", ".join(cls.removes))
+        extras.append("reciprocal" if cls.reciprocal else "NOT reciprocal")
+        print(f"    ({'; '.join(extras)})")
+        print()
+    print("presets: " + "; ".join(f"{k} = {v}" for k, v in PRESETS.items()))
+    return 0
+
+
+def demo(args) -> int:
+    from .report.demo import run_demo
+
+    run_demo(Path(args.out))
+    return 0
+
+
+def _not_yet(args) -> int:
+    raise SpacepolError(f"'{args.command}' is not available yet in this version")
+
+
+run = optimize = compare = diagnose = ladder = sky = contrast = _not_yet

@@ -1,0 +1,1 @@
+"""Inference: priors, likelihoods and engines (emcee, GA, nlopt, scipy DE)."""

@@ -1,0 +1,239 @@
+"""Reading and writing measurement files (DESIGN.md, "Measurement files", fixed).
+
+CSV, UTF-8, optional leading ``# key: value`` metadata lines, one header row, data rows,
+angles in degrees.  Required: ``theta_i``, ``theta_r`` and an observable (``dop``, ``brdf`` or
+``s0,s1,s2``), unless the file is only a geometry (``forward``).  NIST's Mueller-matrix BRDF
+layout is recognised by its header and handed to :mod:`spacepol.io.nist`.
+
+Every problem is reported as one :class:`InputFileError` naming file, line and column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io as _io
+import os
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputFileError
+from ..physics.geometry import Geometry
+
+GEOMETRY_COLUMNS = ("theta_i", "theta_r", "dphi", "wavelength_um")
+OBSERVABLE_COLUMNS = ("dop", "dop_err", "brdf", "brdf_err", "s0", "s1", "s2", "s3", "aop", "aop_err")
+KNOWN_COLUMNS = GEOMETRY_COLUMNS + OBSERVABLE_COLUMNS
+
+
+@dataclass
+class Dataset:
+    """Measurements at N geometries.  Absent observables are ``None``; angles in degrees."""
+
+    theta_i: np.ndarray
+    theta_r: np.ndarray
+    dphi: np.ndarray
+    wavelength_um: np.ndarray | None = None
+    dop: np.ndarray | None = None
+    dop_err: np.ndarray | None = None
+    brdf: np.ndarray | None = None  # sr^-1
+    brdf_err: np.ndarray | None = None
+    stokes: np.ndarray | None = None  # (4, N): s0..s3 for unpolarized incidence (s3 may be 0)
+    aop: np.ndarray | None = None  # deg
+    aop_err: np.ndarray | None = None
+    mueller: np.ndarray | None = None  # (4, 4, N) BRDF Mueller matrix (sr^-1), when measured
+    metadata: dict = field(default_factory=dict)
+    source: str = ""
+
+    def __len__(self):
+        return len(self.theta_i)
+
+    @property
+    def geometry(self) -> Geometry:
+        if not hasattr(self, "_geometry"):
+            self._geometry = Geometry(self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
+        return self._geometry
+
+    @property
+    def observables(self) -> list[str]:
+        names = [n for n in ("dop", "brdf", "aop") if getattr(self, n) is not None]
+        if self.stokes is not None:
+            names.append("stokes")
+        if self.mueller is not None:
+            names.append("mueller")
+        return names
+
+    def select(self, mask) -> "Dataset":
+        """A subset of the rows (boolean mask or indices)."""
+        idx = np.arange(len(self))[mask]
+        changes = {}
+        for name in ("theta_i", "theta_r", "dphi", "wavelength_um", "dop", "dop_err", "brdf", "brdf_err", "aop", "aop_err"):
+            value = getattr(self, name)
+            changes[name] = None if value is None else value[idx]
+        changes["stokes"] = None if self.stokes is None else self.stokes[:, idx]
+        changes["mueller"] = None if self.mueller is None else self.mueller[:, :, idx]
+        return replace(self, **changes)
+
+    def in_plane(self, tolerance_deg: float = 1e-6) -> "Dataset":
+        """Rows in the plane of incidence: dphi = 0 (retro side) or 180 deg (specular side)."""
+        off = np.abs(np.sin(np.radians(self.dphi)))
+        return self.select(off < np.sin(np.radians(tolerance_deg)) + 1e-12)
+
+    def at_wavelength(self, wavelength_um: float, tolerance_um: float = 1e-4) -> "Dataset":
+        if self.wavelength_um is None:
+            raise InputFileError(self.source, "has no wavelength to select on")
+        keep = np.abs(self.wavelength_um - wavelength_um) < tolerance_um
+        if not keep.any():
+            have = ", ".join(f"{w:g}" for w in np.unique(self.wavelength_um))
+            raise InputFileError(self.source, f"no rows at wavelength {wavelength_um:g} um (have {have})")
+        out = self.select(keep)
+        out.metadata = {**self.metadata, "wavelength_um": wavelength_um}
+        return out
+
+
+def _parse_metadata(lines, path):
+    meta, first_data = {}, 0
+    for number, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if not stripped:
+            first_data = number
+            continue
+        if not stripped.startswith("#"):
+            break
+        first_data = number
+        body = stripped.lstrip("#").strip()
+        if not body:
+            continue
+        key, sep, value = body.partition(":")
+        if not sep:
+            raise InputFileError(path, f"metadata line '{stripped}' is not '# key: value'", line=number)
+        meta[key.strip()] = value.strip()
+    return meta, first_data
+
+
+def _number(text, path, line, column):
+    try:
+        value = float(text)
+    except ValueError:
+        shown = text if text.strip() else "(empty)"
+        raise InputFileError(path, f"'{shown}' is not a number", line=line, column=column) from None
+    if not np.isfinite(value):
+        raise InputFileError(path, f"'{text}' is not a finite number", line=line, column=column)
+    return value
+
+
+def read_measurements(path, require_observable: bool = True) -> Dataset:
+    """Read a spacepol CSV or a NIST Mueller BRDF file."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(path, "file not found")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputFileError(path, f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    lines = text.splitlines()
+    meta, skip = _parse_metadata(lines, path)
+    if skip >= len(lines):
+        raise InputFileError(path, "empty file: no header row")
+    header_line = skip + 1
+    header = [h.strip() for h in next(csv.reader([lines[skip]]))]
+
+    from .nist import is_nist_header, read_nist_rows
+
+    if is_nist_header(header):
+        return read_nist_rows(path, header, lines[skip + 1 :], header_line, meta)
+
+    for column in header:
+        if column not in KNOWN_COLUMNS:
+            raise InputFileError(
+                path, f"unknown column '{column}' (known: {', '.join(KNOWN_COLUMNS)})", line=header_line
+            )
+    if len(set(header)) != len(header):
+        raise InputFileError(path, "a column name appears twice in the header", line=header_line)
+    for required in ("theta_i", "theta_r"):
+        if required not in header:
+            raise InputFileError(path, f"missing required column '{required}'", line=header_line)
+    stokes_cols = [c for c in ("s0", "s1", "s2") if c in header]
+    if stokes_cols and len(stokes_cols) < 3:
+        raise InputFileError(path, "Stokes data need all of s0, s1, s2", line=header_line)
+    has_observable = "dop" in header or "brdf" in header or len(stokes_cols) == 3
+    if require_observable and not has_observable:
+        raise InputFileError(path, "no observable column: need dop, brdf, or s0,s1,s2", line=header_line)
+    for err, base in (("dop_err", "dop"), ("brdf_err", "brdf"), ("aop_err", "aop")):
+        if err in header and base not in header:
+            raise InputFileError(path, f"column '{err}' without '{base}'", line=header_line)
+
+    columns: dict[str, list[float]] = {c: [] for c in header}
+    reader = csv.reader(_io.StringIO("\n".join(lines[skip + 1 :])))
+    for offset, row in enumerate(reader, start=1):
+        line = header_line + offset
+        if not row or all(not cell.strip() for cell in row):
+            continue
+        if len(row) != len(header):
+            raise InputFileError(path, f"{len(row)} fields, header has {len(header)}", line=line)
+        for column, cell in zip(header, row):
+            value = _number(cell.strip(), path, line, column)
+            _check_value(value, column, path, line)
+            columns[column].append(value)
+    if not columns["theta_i"]:
+        raise InputFileError(path, "empty file: header but no data rows", line=header_line)
+
+    arrays = {c: np.asarray(v) for c, v in columns.items()}
+    n = len(arrays["theta_i"])
+    wavelength = arrays.get("wavelength_um")
+    if wavelength is None and "wavelength_um" in meta:
+        wl = _number(meta["wavelength_um"], path, None, "wavelength_um metadata")
+        wavelength = np.full(n, wl)
+    stokes = None
+    if len(stokes_cols) == 3:
+        s3 = arrays.get("s3", np.zeros(n))
+        stokes = np.array([arrays["s0"], arrays["s1"], arrays["s2"], s3])
+    return Dataset(
+        theta_i=arrays["theta_i"],
+        theta_r=arrays["theta_r"],
+        dphi=arrays.get("dphi", np.full(n, 180.0)),
+        wavelength_um=wavelength,
+        dop=arrays.get("dop"),
+        dop_err=arrays.get("dop_err"),
+        brdf=arrays.get("brdf"),
+        brdf_err=arrays.get("brdf_err"),
+        stokes=stokes,
+        aop=arrays.get("aop"),
+        aop_err=arrays.get("aop_err"),
+        metadata=meta,
+        source=str(path),
+    )
+
+
+def _check_value(value, column, path, line):
+    if column in ("theta_i", "theta_r") and abs(value) >= 90:
+        raise InputFileError(path, f"angle {value:g} deg: |angle| must be below 90", line=line, column=column)
+    if column == "dop" and not 0 <= value <= 1:
+        raise InputFileError(path, f"DOP {value:g} outside [0, 1]", line=line, column=column)
+    if column.endswith("_err") and value < 0:
+        raise InputFileError(path, f"negative uncertainty {value:g}", line=line, column=column)
+    if column == "wavelength_um" and value <= 0:
+        raise InputFileError(path, f"wavelength {value:g} um must be positive", line=line, column=column)
+    if column in ("brdf", "s0") and value < 0:
+        raise InputFileError(path, f"negative intensity {value:g}", line=line, column=column)
+
+
+def write_table(path, columns: dict, metadata: dict | None = None) -> None:
+    """Write a CSV with ``# key: value`` metadata, atomically (a temp file renamed into place)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[c], dtype=float) for c in names])
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            for key, value in (metadata or {}).items():
+                fh.write(f"# {key}: {value}\n")
+            fh.write(",".join(names) + "\n")
+            for row in data:
+                fh.write(",".join(repr(float(v)) for v in row) + "\n")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

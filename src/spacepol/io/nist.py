@@ -1,0 +1,82 @@
+"""NIST full Mueller-matrix BRDF layout (Germer, Appl. Opt. 56, 2017; data/ptfe/).
+
+Columns: ``lambda`` (um), ``thetai`` (deg; incidence stored negative), ``phii``, ``thetar``,
+``phir`` (deg), ``fr11`` (sr^-1), then the 15 ratios m12 ... m44 = f_rij / f_r11 (header
+``f_r12/f_r11`` or ``m12``).  NIST's source with negative theta_i at phi_i = 0 lies at azimuth
+180 deg, and phi_r = 0 is the forward (specular) direction.  In spacepol's convention
+(source at phi_i = 0) that is  dphi = phi_source - phi_r  with phi_source = phi_i + 180 deg
+when theta_i < 0; the specular plane is then dphi = 180 deg as DESIGN.md fixes.
+"""
+
+from __future__ import annotations
+
+import csv
+import io as _io
+
+import numpy as np
+
+from ..errors import InputFileError
+
+_RATIO_NAMES = [f"m{i}{j}" for i in range(1, 5) for j in range(1, 5)][1:]
+
+
+def is_nist_header(header) -> bool:
+    lowered = [h.lower() for h in header]
+    return len(lowered) >= 21 and lowered[0] == "lambda" and lowered[1] == "thetai"
+
+
+def _wrap_deg(angle):
+    return (np.asarray(angle) + 180.0) % 360.0 - 180.0
+
+
+def read_nist_rows(path, header, lines, header_line, meta):
+    from .measurements import Dataset, _number
+
+    if len(header) != 21:
+        raise InputFileError(path, f"NIST Mueller layout needs 21 columns, header has {len(header)}", line=header_line)
+    names = ["lambda", "thetai", "phii", "thetar", "phir", "fr11"] + _RATIO_NAMES
+    rows = []
+    for offset, row in enumerate(csv.reader(_io.StringIO("\n".join(lines))), start=1):
+        line = header_line + offset
+        if not row or all(not c.strip() for c in row):
+            continue
+        if len(row) != 21:
+            raise InputFileError(path, f"{len(row)} fields, header has 21", line=line)
+        values = [_number(c.strip(), path, line, header[i]) for i, c in enumerate(row)]
+        for col in (1, 3):
+            if abs(values[col]) >= 90:
+                raise InputFileError(path, f"angle {values[col]:g} deg: |angle| must be below 90", line=line, column=header[col])
+        if values[5] < 0:
+            raise InputFileError(path, f"negative BRDF {values[5]:g}", line=line, column=header[5])
+        rows.append(values)
+    if not rows:
+        raise InputFileError(path, "empty file: header but no data rows", line=header_line)
+    data = np.asarray(rows)
+    col = {name: data[:, i] for i, name in enumerate(names)}
+
+    theta_i_signed, theta_r_signed = col["thetai"], col["thetar"]
+    phi_source = col["phii"] + np.where(theta_i_signed < 0, 180.0, 0.0)
+    phi_detector = col["phir"] + np.where(theta_r_signed < 0, 180.0, 0.0)
+    dphi = _wrap_deg(phi_source - phi_detector)
+    dphi = np.where(dphi == -180.0, 180.0, dphi)
+
+    fr11 = col["fr11"]
+    ratios = np.ones((4, 4, len(fr11)))
+    for name in _RATIO_NAMES:
+        ratios[int(name[1]) - 1, int(name[2]) - 1] = col[name]
+    mueller = ratios * fr11
+    stokes = mueller[:, 0, :].copy()
+    dop = np.sqrt(ratios[1, 0] ** 2 + ratios[2, 0] ** 2 + ratios[3, 0] ** 2)
+    meta = {"source": "NIST Mueller-matrix BRDF", **meta}
+    return Dataset(
+        theta_i=np.abs(theta_i_signed),
+        theta_r=np.abs(theta_r_signed),
+        dphi=dphi,
+        wavelength_um=col["lambda"],
+        dop=dop,
+        brdf=fr11,
+        stokes=stokes,
+        mueller=mueller,
+        metadata=meta,
+        source=str(path),
+    )

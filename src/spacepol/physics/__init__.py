@@ -1,0 +1,7 @@
+"""The forward pBRDF model: geometry, Fresnel, facet statistics, effects, and their composition."""
+
+from .geometry import Geometry
+from .model import Model, Prediction, build_model
+from .effects import Effect, registry
+
+__all__ = ["Geometry", "Model", "Prediction", "build_model", "Effect", "registry"]

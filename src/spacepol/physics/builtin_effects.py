@@ -1,0 +1,311 @@
+"""The built-in effects (DESIGN.md's table, fixed names)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..infer.priors import Uniform
+from . import facets, fresnel
+from .effect import Context, Effect
+from .parameter import Parameter
+from .shadowing import PAPER_CONSTANTS, paper_shadowing
+
+
+def _rotator(two_eta_cos, two_eta_sin):
+    """Stokes basis rotation L(eta): S1' = c S1 + s S2, S2' = -s S1 + c S2."""
+    one, zero = np.ones_like(two_eta_cos), np.zeros_like(two_eta_cos)
+    return np.array(
+        [
+            [one, zero, zero, zero],
+            [zero, two_eta_cos, two_eta_sin, zero],
+            [zero, -two_eta_sin, two_eta_cos, zero],
+            [zero, zero, zero, one],
+        ]
+    )
+
+
+def _matmul(a, b):
+    """(4, 4, ...) x (4, 4, ...) Mueller product, broadcasting over the trailing axes."""
+    return np.einsum("ij...,jk...->ik...", a, b)
+
+
+class Specular(Effect):
+    name = "specular"
+    parameters = (
+        Parameter("n", "", Uniform(0.1, 5.0), 1.5, "real part of the complex refractive index N = n + ik", physical=(1e-6, np.inf)),
+        Parameter("k", "", Uniform(0.0, 20.0), 0.0, "extinction coefficient, imaginary part of N", physical=(0.0, np.inf)),
+        Parameter("sigma", "", Uniform(0.02, 0.8), 0.2, "facet slope standard deviation per axis (eq 1)", physical=(1e-6, np.inf)),
+        Parameter("ks", "", Uniform(0.0, 1.0), 0.5, "specular weight k_s of f = f_dd + k_s f_sp (eq 10)", physical=(0.0, np.inf)),
+    )
+    description = (
+        "Mirror-like reflection from randomly tilted microfacets (paper eqs 1-6, 20-21). Facet "
+        "slopes are Gaussian with standard deviation sigma per axis (Beckmann alpha = sqrt(2) sigma); each "
+        "facet reflects with the exact Fresnel Mueller matrix of the complex index n + ik at the local "
+        "angle beta, rotated from the facet's plane of incidence into the macroscopic planes (eta_i, "
+        "eta_r). It polarizes light perpendicular to the plane of scattering (s), most strongly near "
+        "Brewster's angle for dielectrics; roughness sigma widens the lobe but leaves the DOP of the "
+        "lobe itself unchanged."
+    )
+
+    def distribution(self, ctx: Context):
+        geo = ctx.geometry
+        if ctx.anisotropic_slopes is not None:
+            sx, sy, psi = ctx.anisotropic_slopes
+            fn = facets.ggx_anisotropic if ctx.facet_shape == "ggx" else facets.beckmann_anisotropic
+            return fn(geo.tan2_alpha, geo.sec4_alpha, geo.phi_h, sx, sy, psi)
+        fn = facets.ggx if ctx.facet_shape == "ggx" else facets.beckmann
+        return fn(geo.tan2_alpha, geo.sec4_alpha, ctx["sigma"])
+
+    def lobe(self, ctx: Context):
+        # The specular lobe is assembled by the Model (it must pass through specular_factor
+        # and modify_specular hooks before it is added), see specular_lobe().
+        return None
+
+    def specular_lobe(self, ctx: Context):
+        geo = ctx.geometry
+        scalar = ctx["ks"] * self.distribution(ctx) * geo.specular_jacobian
+        if ctx.mueller:
+            if ctx.fresnel_amplitudes is not None:
+                r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
+            else:
+                r_s, r_p = fresnel.amplitudes(ctx["n"] + 1j * ctx["k"], geo.cos_beta, geo.sin2_beta)
+            m_f = fresnel.mueller_from_amplitudes(*np.broadcast_arrays(r_s, r_p))
+            rot_in = _rotator(np.cos(2 * geo.eta_i), np.sin(2 * geo.eta_i))
+            rot_out = _rotator(geo.cos_2eta_r, geo.sin_2eta_r)
+            return _matmul(rot_out, _matmul(m_f, rot_in)) * scalar
+        if ctx.fresnel_amplitudes is not None:
+            r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
+            big_rs, big_rp = np.abs(r_s) ** 2, np.abs(r_p) ** 2
+        else:
+            big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
+        half_diff = 0.5 * scalar * (big_rs - big_rp)
+        s0 = 0.5 * scalar * (big_rs + big_rp)
+        return np.array(np.broadcast_arrays(s0, half_diff * geo.cos_2eta_r, -half_diff * geo.sin_2eta_r, np.zeros_like(s0)))
+
+
+class Shadowing(Effect):
+    name = "shadowing"
+    parameters = tuple(
+        Parameter(name, "", Uniform(lo, hi), PAPER_CONSTANTS[name], text, fixed=True, physical=(0.0, np.inf))
+        for name, lo, hi, text in [
+            ("sigma_p", 0.0, 0.2, "empirical shadowing strength (eq 8)"),
+            ("sigma_r", 0.0, 0.2, "empirical masking relief term (eq 7)"),
+            ("u_p", 0.0, 30.0, "growth of w_p with facet tilt (eq 8)"),
+            ("v_p", 0.05, 10.0, "tilt scale of w_p (eq 8)"),
+        ]
+    )
+    requires = ("specular",)
+    description = (
+        "The paper's empirical shadowing/masking G (eqs 7-8, corrected tan(beta_p)): facets hidden "
+        "from the source or the detector do not contribute. Darkens the specular lobe at grazing "
+        "incidence or exit; it multiplies S0, S1 and S2 alike, so it changes DOP only through the "
+        "balance with the diffuse lobes. Its four constants are fixed at the paper's values unless freed."
+    )
+
+    def specular_factor(self, ctx):
+        params = [ctx[name] for name in PAPER_CONSTANTS]
+        if all(np.ndim(v) == 0 for v in params):
+            key = ("paper_shadowing",) + tuple(float(v) for v in params)
+            return ctx.geometry.cached(key, lambda: paper_shadowing(ctx.geometry, *params))
+        return paper_shadowing(ctx.geometry, *params)
+
+
+class Smith(Effect):
+    name = "smith"
+    excludes = ("shadowing",)
+    requires = ("specular",)
+    description = (
+        "Smith's uncorrelated shadowing-masking G1(theta_i) G1(theta_r) for the same facet statistics "
+        "as the specular lobe (exact Lambda for Gaussian slopes, or Trowbridge-Reitz with ggx; "
+        "anisotropic widths projected on each beam's azimuth). Physically consistent replacement of "
+        "the paper's empirical `shadowing`; darkens grazing geometries, DOP of the lobe unchanged."
+    )
+
+    def specular_factor(self, ctx):
+        geo = ctx.geometry
+        g1 = facets.smith_g1_ggx if ctx.facet_shape == "ggx" else facets.smith_g1_beckmann
+        tan_i = np.sqrt(1.0 - geo.cos_ti**2) / geo.cos_ti
+        tan_r = np.sqrt(1.0 - geo.cos_tr**2) / geo.cos_tr
+        if ctx.anisotropic_slopes is not None:
+            sx, sy, psi = ctx.anisotropic_slopes
+            phi_i = np.where(geo.theta_i < 0, np.pi, 0.0)
+            phi_r = -np.radians(geo.dphi) + np.where(geo.theta_r < 0, np.pi, 0.0)
+            var_i = facets.slope_widths(sx, sy, psi, phi_i)[1]
+            var_r = facets.slope_widths(sx, sy, psi, phi_r)[1]
+        else:
+            var_i = var_r = ctx["sigma"] ** 2
+        return g1(tan_i, var_i) * g1(tan_r, var_r)
+
+
+class Body(Effect):
+    name = "body"
+    parameters = (
+        Parameter("rho_d", "", Uniform(0.0, 1.0), 0.1, "Kubelka-Munk body reflectance rho_d (eq 12)", physical=(0.0, np.inf)),
+    )
+    reciprocal = False
+    description = (
+        "Depolarized body (volume) scattering of the Kubelka-Munk model, in the paper's form "
+        "f_dd = (cos(theta_r)/pi) rho_d diag(1,0,0,0) (eq 11). Unpolarized, so it lowers DOP wherever the "
+        "specular lobe is weak. Note: because of its cos(theta_r) factor it is neither Lambertian "
+        "(rho_d/pi would be) nor reciprocal; eq 23's DOP follows only with this depolarizing M^d."
+    )
+
+    def lobe(self, ctx):
+        return ctx.depolarized(ctx["rho_d"] * ctx.geometry.cos_tr / np.pi)
+
+
+class PolarizedDiffuse(Effect):
+    name = "polarized_diffuse"
+    parameters = (
+        Parameter("rho_pd", "", Uniform(0.0, 1.0), 0.1, "albedo of the subsurface Lambertian light", physical=(0.0, np.inf)),
+    )
+    requires = ("specular",)
+    description = (
+        "Light refracted into the material, scattered until depolarized, and refracted out again "
+        "(Atkinson & Hancock 2006; the diffuse part of Baek et al. 2018): f = (rho_pd/pi) T(theta_r) D T(theta_i) "
+        "with Fresnel power transmittances T = 1 - R of the macroscopic surface. Exit transmission "
+        "favours p, so this light is partly polarized parallel to the exit plane (S1 < 0), most at "
+        "grazing exit: it raises |DOP| at large theta_r and can flip the sign of S1 far from the specular lobe."
+    )
+
+    def lobe(self, ctx):
+        geo = ctx.geometry
+        n, k = ctx["n"], ctx["k"]
+
+        def transmission(cos_t):
+            sin2 = 1.0 - cos_t**2
+            r_s, r_p = fresnel.power(n, k, cos_t, sin2, sin2 / cos_t)
+            t_s, t_p = 1.0 - r_s, 1.0 - r_p
+            zero = np.zeros_like(t_s)
+            return [0.5 * (t_s + t_p), 0.5 * (t_s - t_p), zero, zero]
+
+        t_in = transmission(geo.cos_ti)
+        t_out = transmission(geo.cos_tr)
+        scale = ctx["rho_pd"] / np.pi
+        return ctx.first_column_times_row([scale * c for c in t_out], t_in)
+
+
+class Depolarization(Effect):
+    name = "depolarization"
+    parameters = (
+        Parameter("d_spec", "", Uniform(0.0, 1.0), 0.1, "fraction of the specular lobe depolarized", physical=(0.0, 1.0)),
+    )
+    requires = ("specular",)
+    description = (
+        "A fraction d_spec of the specularly reflected light is depolarized by multiple scattering "
+        "between facets: the lobe's S1, S2, S3 are scaled by 1 - d_spec, its intensity kept. Lowers the "
+        "DOP of the specular lobe at every angle by the same factor."
+    )
+
+    def modify_specular(self, ctx, lobe):
+        lobe[1:] *= 1.0 - ctx["d_spec"]
+        return lobe
+
+
+class Anisotropy(Effect):
+    name = "anisotropy"
+    parameters = (
+        Parameter("sigma_x", "", Uniform(0.02, 0.8), 0.2, "slope standard deviation along the surface x' axis", physical=(1e-6, np.inf)),
+        Parameter("sigma_y", "", Uniform(0.02, 0.8), 0.2, "slope standard deviation along the surface y' axis", physical=(1e-6, np.inf)),
+        Parameter("psi", "deg", Uniform(0.0, 180.0), 0.0, "angle of x' from the source azimuth"),
+    )
+    requires = ("specular",)
+    removes = ("sigma",)
+    description = (
+        "Anisotropic roughness (brushed or rolled metal): slope widths sigma_x, sigma_y along axes "
+        "turned by psi from the plane of incidence replace sigma. The specular lobe stretches along "
+        "the rough axis, so out-of-plane data change with the sample's rotation."
+    )
+
+    def configure(self, ctx):
+        ctx.anisotropic_slopes = (ctx["sigma_x"], ctx["sigma_y"], ctx["psi"])
+
+
+class GGX(Effect):
+    name = "ggx"
+    requires = ("specular",)
+    description = (
+        "Trowbridge-Reitz (GGX) facet slopes instead of Gaussian ones, width a = sqrt(2) sigma: same "
+        "peak curvature, much longer tails, so more light far from the specular direction (and a "
+        "smoother fall of DOP away from it)."
+    )
+
+    def configure(self, ctx):
+        ctx.facet_shape = "ggx"
+
+
+class OxideLayer(Effect):
+    name = "oxide_layer"
+    parameters = (
+        Parameter("thickness_um", "um", Uniform(0.0, 1.0), 0.05, "film thickness", physical=(0.0, np.inf)),
+        Parameter("n_film", "", Uniform(1.0, 2.5), 1.65, "film refractive index (transparent)", physical=(1e-6, np.inf)),
+    )
+    requires = ("specular",)
+    description = (
+        "A thin transparent film (native oxide, coating) on the facets: reflection is the coherent sum "
+        "of the film's two interfaces (Airy formula), so r_s and r_p, and hence DOP, oscillate with "
+        "thickness/wavelength and angle. Needs the wavelength (metadata `wavelength_um` or a column)."
+    )
+
+    def configure(self, ctx):
+        wavelength = ctx.geometry.wavelength_um
+        if wavelength is None or np.any(~np.isfinite(wavelength)):
+            from ..errors import ParameterError
+
+            raise ParameterError("oxide_layer needs the wavelength: add '# wavelength_um: ...' to the data file")
+        substrate = ctx["n"] + 1j * ctx["k"]
+        d, n_f = ctx["thickness_um"], ctx["n_film"]
+        ctx.fresnel_amplitudes = lambda cos, sin2: fresnel.film_amplitudes(substrate, n_f, d, wavelength, cos, sin2)
+
+
+class AngleOffset(Effect):
+    name = "angle_offset"
+    parameters = (
+        Parameter("delta_deg", "deg", Uniform(-3.0, 3.0), 0.0, "goniometer zero error added to theta_i and theta_r", physical=(-89.0, 89.0)),
+    )
+    description = (
+        "A goniometer zero error: the true angles are theta_i + delta and theta_r + delta. Shifts the "
+        "whole DOP curve along the angle axis (the geometry is then recomputed for each parameter set)."
+    )
+
+    def transform_geometry(self, params, geometry):
+        return geometry.with_offset(params["delta_deg"])
+
+
+class Extinction(Effect):
+    name = "extinction"
+    parameters = (
+        Parameter("e", "", Uniform(0.5, 1.0), 0.95, "analyser efficiency: measured DOP = e x true DOP", physical=(0.0, 1.0)),
+    )
+    description = (
+        "An imperfect analyser (finite extinction ratio) sees S1, S2, S3 scaled by e, so the measured "
+        "DOP is e times the true one at every angle; intensity unchanged. On DOP and BRDF data it is a "
+        "twin of `depolarization` wherever the diffuse light is unpolarized."
+    )
+
+    def modify_stokes(self, ctx, total):
+        total[1:] *= ctx["e"]
+        return total
+
+
+class DopBias(Effect):
+    name = "dop_bias"
+    parameters = (
+        Parameter("bias", "", Uniform(0.0, 0.2), 0.02, "noise floor of the DOP estimator", physical=(0.0, 1.0)),
+    )
+    description = (
+        "Noise bias of a measured DOP: with noisy Stokes parameters the DOP estimate is Rician, "
+        "sqrt(DOP^2 + bias^2) on average, so low DOP reads high and DOP never reaches 0. Applied to the "
+        "measured DOP only (the Stokes vector is the physical one); the estimate may exceed 1 by at most "
+        "sqrt(1 + bias^2) - 1."
+    )
+
+    def modify_dop(self, ctx, dop):
+        return np.sqrt(dop**2 + ctx["bias"] ** 2)
+
+
+BUILTIN_EFFECTS = (
+    Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
+    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias,
+)
+PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

@@ -1,0 +1,156 @@
+"""The Effect interface: one physical ingredient of the pBRDF, composable with ``+``.
+
+An effect declares the parameters it owns (names must be unique across a model, as in lmfit),
+the effects whose parameters or lobe it uses (``requires``), and the effects it cannot be
+combined with (``excludes``).  It takes part in the evaluation through any of these hooks, called in
+this order for every effect of the model:
+
+1. ``transform_geometry(params, geometry)``: e.g. a goniometer zero offset;
+2. ``configure(ctx)``: choose the facet distribution, widths or Fresnel coefficients;
+3. ``specular_factor(ctx)``: a multiplicative factor of the specular lobe (shadowing);
+4. ``modify_specular(ctx, lobe)``: change the specular lobe (e.g. depolarize part of it);
+5. ``lobe(ctx)``: an additive lobe (body scattering, subsurface light);
+6. ``modify_stokes(ctx, total)``: the instrument seen on the total (analyser extinction);
+7. ``modify_dop(ctx, dop)``: the estimator of the measured DOP (noise bias).
+
+Lobes are arrays of shape (4, *shape) (the Stokes vector for unpolarized incidence) or
+(4, 4, *shape) (the Mueller matrix, when the caller asks for it): row operations such as
+``lobe[1:] *= f`` work on both.  ``ctx.depolarized(f)`` builds a lobe that only scatters intensity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from .geometry import Geometry
+from .parameter import Parameter
+
+
+@dataclass
+class Context:
+    """Everything an effect may read during one evaluation."""
+
+    params: dict
+    geometry: Geometry
+    mueller: bool
+    shape: tuple
+    facet_shape: str = "beckmann"  # or "ggx"
+    anisotropic_slopes: tuple | None = None  # (sigma_x, sigma_y, psi_deg)
+    fresnel_amplitudes: Callable | None = None  # (cos, sin2) -> (r_s, r_p); None = bulk N = n + ik
+    notes: dict = field(default_factory=dict)
+
+    def __getitem__(self, name):
+        return self.params[name]
+
+    def zeros(self):
+        lead = (4, 4) if self.mueller else (4,)
+        return np.zeros(lead + self.shape)
+
+    def depolarized(self, value):
+        """A lobe whose light is unpolarized with intensity ``value`` (Mueller diag(1,0,0,0))."""
+        out = self.zeros()
+        if self.mueller:
+            out[0, 0] = value
+        else:
+            out[0] = value
+        return out
+
+    def first_column_times_row(self, column, row):
+        """Lobe of a Mueller matrix column (x) row: ``row`` is applied to the incident Stokes vector.
+
+        Used by lobes that depolarize inside the material: only how much intensity enters
+        (``row``, its first element for unpolarized light) and the state it leaves in (``column``) matter.
+        """
+        out = self.zeros()
+        if self.mueller:
+            for i in range(4):
+                for j in range(4):
+                    out[i, j] = column[i] * row[j]
+        else:
+            for i in range(4):
+                out[i] = column[i] * row[0]
+        return out
+
+
+class Effect:
+    """Base class of all effects.  Subclasses set the class attributes and override hooks."""
+
+    name: str = ""
+    parameters: tuple[Parameter, ...] = ()
+    requires: tuple[str, ...] = ()  # effect names that must be in the model too
+    excludes: tuple[str, ...] = ()
+    removes: tuple[str, ...] = ()  # parameters of other effects this one makes unused
+    reciprocal: bool = True  # does it keep M(i -> r) = Q M(r -> i)^T Q ?
+    description: str = ""
+
+    # lmfit-style composition: effect + effect -> Model
+    def __add__(self, other):
+        from .model import Model
+
+        return Model([self]) + other
+
+    def __repr__(self):
+        return f"<effect {self.name}>"
+
+    def transform_geometry(self, params, geometry: Geometry) -> Geometry:
+        return geometry
+
+    def configure(self, ctx: Context) -> None:
+        pass
+
+    def specular_factor(self, ctx: Context):
+        return None
+
+    def modify_specular(self, ctx: Context, lobe):
+        return lobe
+
+    def lobe(self, ctx: Context):
+        return None
+
+    def modify_stokes(self, ctx: Context, total):
+        return total
+
+    def modify_dop(self, ctx: Context, dop):
+        return dop
+
+
+_STAGES = {"lobe", "specular_factor", "modify_specular", "modify_stokes", "modify_dop"}
+
+
+def effect(name: str, *, stage: str, parameters=(), requires=(), description: str = "", reciprocal: bool = True):
+    """Decorator that turns a function into an effect class.
+
+    ``stage`` names the hook the function implements; it is called as ``fn(ctx, ...)`` with
+    the lobe/total/dop as second argument where the hook has one, and the effect's own
+    parameters as keyword arguments::
+
+        @effect("sheen", stage="lobe", parameters=[Parameter("a", "", Uniform(0, 1), 0.1, "...")])
+        def sheen(ctx, a):
+            return ctx.depolarized(a * ctx.geometry.cos_tr / np.pi)
+    """
+    if stage not in _STAGES:
+        raise ValueError(f"effect '{name}': unknown stage '{stage}' (choose from {sorted(_STAGES)})")
+
+    def wrap(fn):
+        own = tuple(parameters)
+
+        def hook(self, ctx, *args):
+            kwargs = {p.name: ctx.params[p.name] for p in own}
+            return fn(ctx, *args, **kwargs)
+
+        attrs = {
+            "name": name,
+            "parameters": own,
+            "requires": tuple(requires),
+            "description": description or (fn.__doc__ or "").strip(),
+            "reciprocal": reciprocal,
+            stage: hook,
+            "__module__": fn.__module__,
+            "__doc__": fn.__doc__,
+        }
+        return type(fn.__name__, (Effect,), attrs)
+
+    return wrap

@@ -1,0 +1,87 @@
+"""Fresnel reflection at a facet for a complex index N = n + ik (time dependence exp(-i w t)).
+
+Two forms, checked against each other and against ``tmm``:
+
+* ``amplitudes``: complex r_s, r_p (needed for the full Mueller matrix, thin films).
+  Convention: the Stokes basis of each beam is (s, p, d) right-handed with the same s for the
+  incident and reflected beam, so at normal incidence r_s = -r_p (a mirror).
+* ``power``: the real power reflectances R_s, R_p of paper eqs 14-19 with the corrected eq 15
+  (``sin(beta) tan(beta)``; ERRATA.md).  Cheaper: it is what DOP and BRDF need for unpolarized
+  incidence, so it is the hot path of an inversion.
+
+``power_paper_eq15`` keeps the printed (wrong) eq 15 so a test can show what the typo does.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def amplitudes(N, cos_theta, sin2_theta):
+    """Complex amplitude reflection coefficients (r_s, r_p) from vacuum onto index ``N``."""
+    N = np.asarray(N, dtype=complex)
+    root = np.sqrt(N**2 - sin2_theta)  # = N cos(theta_t); principal branch has Im >= 0
+    r_s = (cos_theta - root) / (cos_theta + root)
+    r_p = (N**2 * cos_theta - root) / (N**2 * cos_theta + root)
+    return r_s, r_p
+
+
+def film_amplitudes(N_substrate, n_film, thickness_um, wavelength_um, cos_theta, sin2_theta):
+    """(r_s, r_p) of a substrate under one homogeneous film (Airy summation of the two interfaces)."""
+    n_film = np.asarray(n_film, dtype=complex)
+    N_substrate = np.asarray(N_substrate, dtype=complex)
+    root_f = np.sqrt(n_film**2 - sin2_theta)  # n_f cos(theta_f)
+    root_s = np.sqrt(N_substrate**2 - sin2_theta)
+    r01_s = (cos_theta - root_f) / (cos_theta + root_f)
+    r12_s = (root_f - root_s) / (root_f + root_s)
+    r01_p = (n_film**2 * cos_theta - root_f) / (n_film**2 * cos_theta + root_f)
+    r12_p = (N_substrate**2 * root_f - n_film**2 * root_s) / (N_substrate**2 * root_f + n_film**2 * root_s)
+    phase = np.exp(2j * (2 * np.pi / wavelength_um) * thickness_um * root_f)
+    r_s = (r01_s + r12_s * phase) / (1 + r01_s * r12_s * phase)
+    r_p = (r01_p + r12_p * phase) / (1 + r01_p * r12_p * phase)
+    return r_s, r_p
+
+
+def _a_b2(n, k, sin2_theta):
+    """A and B^2 of eqs 16-19."""
+    d = n**2 - k**2 - sin2_theta
+    sqrt_c = np.sqrt(4 * n**2 * k**2 + d**2)
+    a = np.sqrt(np.maximum(0.5 * (sqrt_c + d), 0.0))
+    b2 = np.maximum(0.5 * (sqrt_c - d), 0.0)
+    return a, b2
+
+
+def power(n, k, cos_theta, sin2_theta, sin_tan_theta):
+    """Power reflectances (R_s, R_p), eqs 14-19 with the corrected eq 15.
+
+    ``sin_tan_theta`` is sin(theta) tan(theta), passed in because it is a geometry-only term.
+    """
+    a, b2 = _a_b2(n, k, sin2_theta)
+    r_s = ((a - cos_theta) ** 2 + b2) / ((a + cos_theta) ** 2 + b2)
+    r_p = r_s * ((a - sin_tan_theta) ** 2 + b2) / ((a + sin_tan_theta) ** 2 + b2)
+    return r_s, r_p
+
+
+def power_paper_eq15(n, k, cos_theta, sin2_theta):
+    """The paper's printed eq 15 (sin*cos instead of sin*tan).  Wrong; kept for a regression test."""
+    a, b2 = _a_b2(n, k, sin2_theta)
+    r_s = ((a - cos_theta) ** 2 + b2) / ((a + cos_theta) ** 2 + b2)
+    sin_cos = np.sqrt(sin2_theta) * cos_theta
+    r_p = r_s * ((a - sin_cos) ** 2 + b2) / ((a + sin_cos) ** 2 + b2)
+    return r_s, r_p
+
+
+def mueller_from_amplitudes(r_s, r_p):
+    """Non-depolarizing Mueller matrix of reflection, shape (4, 4, ...), eq 21's M_F."""
+    rs2, rp2 = np.abs(r_s) ** 2, np.abs(r_p) ** 2
+    cross = r_s * np.conj(r_p)
+    zero = np.zeros_like(rs2)
+    a, b, c, d = 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), cross.real, cross.imag
+    return np.array(
+        [
+            [a, b, zero, zero],
+            [b, a, zero, zero],
+            [zero, zero, c, d],
+            [zero, zero, -d, c],
+        ]
+    )

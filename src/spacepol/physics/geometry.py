@@ -1,0 +1,140 @@
+"""Scattering geometry of the microfacet model (paper eqs 2-5), computed with vectors.
+
+Convention (DESIGN.md, fixed): the source is at (theta_i, phi_i = 0), the detector at
+(theta_r, phi_r = -dphi); both direction vectors point away from the surface, so
+dphi = 180 deg is the specular (forward) plane.  Stokes vectors of each beam are expressed in
+the basis (s, p, d), right-handed, with d the propagation direction and s perpendicular to the
+macroscopic plane of incidence (or scattering): S1 > 0 is s-polarized light.
+
+Working with vectors instead of eqs 4-5 gives the sign of eta (which arccos loses) and exact
+limits at normal incidence and at the specular direction for free: the macroscopic s vector is
+defined from the azimuth alone, and where the half vector is parallel to a beam any facet s
+vector will do, provided the same one serves both beams.
+
+A ``Geometry`` is built once per data set; every term that does not depend on the material
+parameters is computed here, so an inversion never recomputes it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+_TINY = 1e-12
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _signed_angle(a, b, axis):
+    """Angle that rotates unit vector ``a`` into ``b`` about ``axis`` (right-hand rule)."""
+    cos = np.sum(a * b, axis=-1)
+    sin = np.sum(np.cross(a, b) * axis, axis=-1)
+    return np.arctan2(sin, cos)
+
+
+@dataclass
+class Geometry:
+    """Angles (degrees) of a set of measurements, and every parameter-free term derived from them.
+
+    ``theta_i``, ``theta_r``, ``dphi`` broadcast together; typically shape (N,), or (P, N)
+    when an effect (``angle_offset``) makes the geometry depend on parameters.
+    """
+
+    theta_i: np.ndarray
+    theta_r: np.ndarray
+    dphi: np.ndarray
+    wavelength_um: np.ndarray | None = None
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self):
+        ti, tr, dp = np.broadcast_arrays(
+            np.asarray(self.theta_i, float), np.asarray(self.theta_r, float), np.asarray(self.dphi, float)
+        )
+        self.theta_i, self.theta_r, self.dphi = ti, tr, dp
+        if self.wavelength_um is not None:
+            self.wavelength_um = np.broadcast_to(np.asarray(self.wavelength_um, float), ti.shape[-1:])
+        self._compute()
+
+    @property
+    def shape(self):
+        return self.theta_i.shape
+
+    @property
+    def size(self) -> int:
+        return self.theta_i.shape[-1]
+
+    def cached(self, key, compute):
+        """Memoise a parameter-free term (e.g. the paper's shadowing at fixed constants)."""
+        if key not in self._cache:
+            self._cache[key] = compute()
+        return self._cache[key]
+
+    def with_offset(self, delta_deg) -> "Geometry":
+        """The same measurements seen through a goniometer whose zero is off by ``delta_deg``."""
+        delta = np.asarray(delta_deg, float)[..., None]
+        return Geometry(self.theta_i + delta, self.theta_r + delta, self.dphi, self.wavelength_um)
+
+    def _compute(self):
+        ti = np.radians(self.theta_i)
+        tr = np.radians(self.theta_r)
+        phi_r = -np.radians(self.dphi)
+        zeros = np.zeros_like(ti)
+
+        # Direction vectors pointing away from the surface (a negative theta lies across the normal).
+        k_i = np.stack([np.sin(ti), zeros, np.cos(ti)], axis=-1)
+        k_r = np.stack([np.sin(tr) * np.cos(phi_r), np.sin(tr) * np.sin(phi_r), np.cos(tr)], axis=-1)
+        self.k_i, self.k_r = k_i, k_r
+        self.cos_ti = np.maximum(k_i[..., 2], _TINY)
+        self.cos_tr = np.maximum(k_r[..., 2], _TINY)
+
+        # Half vector = facet normal for specular reflection.  eq 2: cos(2 beta) = k_i . k_r
+        h_sum = k_i + k_r
+        norm = np.linalg.norm(h_sum, axis=-1)
+        h = h_sum / np.maximum(norm, _TINY)[..., None]
+        self.h = h
+        self.cos_beta = np.clip(norm / 2.0, 0.0, 1.0)
+        self.sin2_beta = np.clip(1.0 - self.cos_beta**2, 0.0, 1.0)
+        self.sin_beta = np.sqrt(self.sin2_beta)
+        self.sin_tan_beta = self.sin2_beta / np.maximum(self.cos_beta, _TINY)
+        # eq 3: cos(alpha) = (cos ti + cos tr) / (2 cos beta) = h_z
+        self.cos_alpha = np.clip(h[..., 2], _TINY, 1.0)
+        h_xy = np.hypot(h[..., 0], h[..., 1])
+        self.sin_alpha = h_xy
+        self.tan2_alpha = (h_xy / self.cos_alpha) ** 2
+        # Azimuth of the facet normal; at alpha = 0 take the plane of incidence (phi = 0),
+        # the limit along the specular plane.
+        self.phi_h = np.where(h_xy > _TINY, np.arctan2(h[..., 1], h[..., 0]), 0.0)
+
+        # Stokes bases.  Macroscopic s vectors come from the azimuth alone, so they have a
+        # limit at normal incidence: s = z x (azimuth unit vector).
+        s_in = np.stack([zeros, np.ones_like(ti), zeros], axis=-1)  # phi_i = 0
+        s_out = np.stack([-np.sin(phi_r), np.cos(phi_r), zeros], axis=-1)
+        # A source or detector with negative theta sits at azimuth + 180 deg.
+        s_in = s_in * np.where(ti < 0, -1.0, 1.0)[..., None]
+        s_out = s_out * np.where(tr < 0, -1.0, 1.0)[..., None]
+        # Facet s vector: normal to the plane containing k_i, h (and k_r).
+        s_f = np.cross(h, k_i)
+        s_f_norm = np.linalg.norm(s_f, axis=-1, keepdims=True)
+        s_f = np.where(s_f_norm > 1e-9, s_f / np.maximum(s_f_norm, _TINY), s_in)
+        d_in, d_out = -k_i, k_r
+        # eta_i rotates the incident (macro) basis into the facet basis about the incident
+        # propagation direction; eta_r rotates the facet exit basis into the macro exit basis.
+        self.eta_i = _signed_angle(s_in, s_f, d_in)
+        self.eta_r = _signed_angle(s_f, s_out, d_out)
+        self.cos_2eta_r = np.cos(2 * self.eta_r)
+        self.sin_2eta_r = np.sin(2 * self.eta_r)
+
+        # Common factor of the specular lobe: 1 / (4 cos^4(alpha) cos(ti) cos(tr)); the facet
+        # distribution supplies the rest (eq 20 = D(alpha) * G * F / (4 cos ti cos tr)).
+        self.specular_jacobian = 1.0 / (4.0 * self.cos_ti * self.cos_tr)
+        self.sec4_alpha = self.cos_alpha**-4
+
+
+def default_grid() -> Geometry:
+    """84 in-plane geometries on the specular side: theta_i in {20, 35, 50, 65}, theta_r 0-80 step 4."""
+    theta_i = np.repeat([20.0, 35.0, 50.0, 65.0], 21)
+    theta_r = np.tile(np.arange(0.0, 81.0, 4.0), 4)
+    return Geometry(theta_i, theta_r, np.full(theta_i.shape, 180.0))

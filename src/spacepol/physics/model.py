@@ -1,0 +1,180 @@
+"""A Model is an ordered set of effects evaluated together: Stokes vector, Mueller matrix, DOP, AoP, BRDF."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError, UnknownNameError
+from .builtin_effects import Specular
+from .effect import Context, Effect
+from .geometry import Geometry
+from .parameter import Parameter
+from .registry import registry
+
+
+@dataclass
+class Prediction:
+    """Model output.  ``stokes`` is (4, *shape) for unpolarized incidence of unit irradiance
+    (so S0 is the BRDF in sr^-1); ``mueller`` is (4, 4, *shape) when asked for."""
+
+    stokes: np.ndarray
+    dop: np.ndarray  # measured DOP (after any estimator effect such as dop_bias)
+    mueller: np.ndarray | None = None
+
+    @property
+    def brdf(self):
+        return self.stokes[0]
+
+    @property
+    def physical_dop(self):
+        return _dop(self.stokes)
+
+    @property
+    def aop_deg(self):
+        """Angle of polarization from the s direction towards p, degrees in (-90, 90]."""
+        return 0.5 * np.degrees(np.arctan2(self.stokes[2], self.stokes[1]))
+
+
+def _dop(stokes):
+    s0 = stokes[0]
+    pol = np.sqrt(stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2)
+    out = np.zeros_like(s0)
+    np.divide(pol, s0, out=out, where=s0 > 0)
+    # |S| <= S0 holds for every lobe; rounding may push a ratio an ulp above 1.
+    return np.minimum(out, 1.0)
+
+
+class Model:
+    def __init__(self, effects):
+        self.effects: list[Effect] = [e() if isinstance(e, type) else e for e in effects]
+        self._check()
+
+    @classmethod
+    def from_string(cls, spec: str) -> "Model":
+        return cls([registry.get(name) for name in registry.expand(spec)])
+
+    def __add__(self, other):
+        if isinstance(other, str):
+            other = Model.from_string(other)
+        others = other.effects if isinstance(other, Model) else [other]
+        return Model(self.effects + list(others))
+
+    @property
+    def name(self) -> str:
+        return "+".join(e.name for e in self.effects)
+
+    def __repr__(self):
+        return f"Model('{self.name}')"
+
+    def _check(self):
+        names = [e.name for e in self.effects]
+        if len(set(names)) != len(names):
+            raise UnknownNameError(f"model '{self.name}': an effect appears twice")
+        for e in self.effects:
+            for need in e.requires:
+                if need not in names:
+                    raise UnknownNameError(f"model '{self.name}': effect '{e.name}' needs '{need}' in the model")
+            for bad in e.excludes:
+                if bad in names:
+                    raise UnknownNameError(f"model '{self.name}': '{e.name}' replaces '{bad}'; use one of them")
+        owner: dict[str, str] = {}
+        for e in self.effects:
+            for p in e.parameters:
+                if p.name in owner:
+                    raise ParameterError(
+                        f"model '{self.name}': parameter '{p.name}' of effect '{e.name}' "
+                        f"collides with effect '{owner[p.name]}'"
+                    )
+                owner[p.name] = e.name
+        self._owner = owner
+        removed = {r for e in self.effects for r in e.removes}
+        self._parameters = [p for e in self.effects for p in e.parameters if p.name not in removed]
+
+    @property
+    def parameters(self) -> list[Parameter]:
+        """Every parameter the model uses, fixed ones included, in effect order."""
+        return list(self._parameters)
+
+    @property
+    def free_parameters(self) -> list[Parameter]:
+        return [p for p in self._parameters if not p.fixed]
+
+    def parameter(self, name: str) -> Parameter:
+        for p in self._parameters:
+            if p.name == name:
+                return p
+        raise UnknownNameError(
+            f"model '{self.name}' has no parameter '{name}' (it has: {', '.join(p.name for p in self._parameters)})"
+        )
+
+    def owner(self, name: str) -> str:
+        return self._owner[name]
+
+    def defaults(self) -> dict[str, float]:
+        return {p.name: p.default for p in self._parameters}
+
+    def _resolve(self, params: dict, check: bool = True) -> tuple[dict, tuple]:
+        known = {p.name for p in self._parameters}
+        unknown = sorted(set(params) - known)
+        if unknown:
+            raise UnknownNameError(
+                f"model '{self.name}' has no parameter(s) {', '.join(unknown)} (it has: {', '.join(sorted(known))})"
+            )
+        values = {p.name: np.asarray(params.get(p.name, p.default), dtype=float) for p in self._parameters}
+        if check:
+            for p in self._parameters:
+                p.check(values[p.name], where=f"model '{self.name}'")
+        batch = np.broadcast_shapes(*(v.shape for v in values.values())) if values else ()
+        if len(batch) > 1:
+            raise ParameterError("parameter values must be scalars or 1-d arrays (one entry per parameter set)")
+        # (P,) -> (P, 1) so parameter sets broadcast against the N geometries.
+        return {k: (v[..., None] if v.ndim else v) for k, v in values.items()}, batch
+
+    def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
+        """Evaluate for parameter sets (scalars or arrays of length P) at N geometries.
+
+        Missing parameters take their defaults.  Returns arrays of shape (N,) for scalar
+        parameters or (P, N) for P parameter sets.  ``check=False`` skips the test for
+        physically impossible values (for callers that already applied the priors).
+        """
+        values, batch = self._resolve(params, check)
+        geo = geometry
+        for e in self.effects:
+            geo = e.transform_geometry(values, geo)
+        shape = np.broadcast_shapes(batch + (1,) if batch else (), geo.shape)
+        ctx = Context(values, geo, mueller, shape)
+        for e in self.effects:
+            e.configure(ctx)
+
+        total = ctx.zeros()
+        specular = next((e for e in self.effects if isinstance(e, Specular)), None)
+        if specular is not None:
+            lobe = specular.specular_lobe(ctx)
+            for e in self.effects:
+                factor = e.specular_factor(ctx)
+                if factor is not None:
+                    lobe = lobe * factor
+            for e in self.effects:
+                lobe = e.modify_specular(ctx, lobe)
+            total = total + lobe
+        for e in self.effects:
+            extra = e.lobe(ctx)
+            if extra is not None:
+                total = total + extra
+        for e in self.effects:
+            total = e.modify_stokes(ctx, total)
+        total = np.broadcast_to(total, total.shape[: 2 if mueller else 1] + shape).copy()
+        stokes = total[:, 0] if mueller else total
+        dop = _dop(stokes)
+        for e in self.effects:
+            dop = e.modify_dop(ctx, dop)
+        return Prediction(stokes=stokes, dop=dop, mueller=total if mueller else None)
+
+    def dop(self, params: dict, geometry: Geometry):
+        return self.evaluate(params, geometry).dop
+
+
+def build_model(spec: str | Model) -> Model:
+    return spec if isinstance(spec, Model) else Model.from_string(spec)

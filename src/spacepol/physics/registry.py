@@ -1,0 +1,89 @@
+"""Effect registry: built-ins, the ``spacepol.effects`` entry-point group, and ``file.py:Name``."""
+
+from __future__ import annotations
+
+import importlib.util
+import inspect
+from importlib.metadata import entry_points
+from pathlib import Path
+
+from ..errors import SpacepolError, UnknownNameError
+from .builtin_effects import BUILTIN_EFFECTS, PRESETS
+from .effect import Effect
+
+
+class Registry:
+    def __init__(self):
+        self._effects: dict[str, type[Effect]] = {}
+        self._entry_points_loaded = False
+
+    def register(self, cls: type[Effect]) -> type[Effect]:
+        if not (inspect.isclass(cls) and issubclass(cls, Effect)):
+            raise SpacepolError(f"{cls!r} is not an Effect subclass (use spacepol.physics.effect.Effect or @effect)")
+        if not cls.name:
+            raise SpacepolError(f"effect class {cls.__name__} has no 'name'")
+        known = self._effects.get(cls.name)
+        if known is not None and known is not cls:
+            raise SpacepolError(f"effect name '{cls.name}' is already registered by {known.__module__}.{known.__name__}")
+        self._effects[cls.name] = cls
+        return cls
+
+    def _load_entry_points(self):
+        if self._entry_points_loaded:
+            return
+        self._entry_points_loaded = True
+        for ep in entry_points(group="spacepol.effects"):
+            try:
+                self.register(ep.load())
+            except Exception as exc:  # a broken plug-in must not hide the built-ins
+                raise SpacepolError(f"entry point '{ep.name}' ({ep.value}) of group spacepol.effects: {exc}") from exc
+
+    def load_file(self, spec: str) -> type[Effect]:
+        """Load ``path/to/file.py:ClassName`` and register it."""
+        path_text, sep, attr = spec.rpartition(":")
+        if not sep or not attr:
+            raise SpacepolError(f"--effect '{spec}': expected path/to/file.py:Name")
+        path = Path(path_text)
+        if not path.is_file():
+            raise SpacepolError(f"--effect '{spec}': file {path} not found")
+        module_name = f"spacepol_user_effect_{path.stem}"
+        module_spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(module_spec)
+        try:
+            module_spec.loader.exec_module(module)
+        except Exception as exc:
+            raise SpacepolError(f"--effect '{spec}': importing {path} failed: {type(exc).__name__}: {exc}") from exc
+        if not hasattr(module, attr):
+            raise SpacepolError(f"--effect '{spec}': {path} defines no '{attr}'")
+        return self.register(getattr(module, attr))
+
+    def names(self) -> list[str]:
+        self._load_entry_points()
+        return list(self._effects)
+
+    def get(self, name: str) -> type[Effect]:
+        self._load_entry_points()
+        try:
+            return self._effects[name]
+        except KeyError:
+            raise UnknownNameError(
+                f"unknown effect '{name}' (known: {', '.join(self._effects)}; presets: {', '.join(PRESETS)})"
+            ) from None
+
+    def expand(self, spec: str) -> list[str]:
+        """'paper+polarized_diffuse' -> ['specular', 'shadowing', 'body', 'polarized_diffuse']."""
+        names: list[str] = []
+        for token in spec.split("+"):
+            token = token.strip()
+            if not token:
+                raise UnknownNameError(f"model '{spec}': empty effect name between '+' signs")
+            for name in PRESETS.get(token, token).split("+"):
+                if name in names:
+                    raise UnknownNameError(f"model '{spec}': effect '{name}' appears twice")
+                names.append(name)
+        return names
+
+
+registry = Registry()
+for _cls in BUILTIN_EFFECTS:
+    registry.register(_cls)

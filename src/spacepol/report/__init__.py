@@ -1,0 +1,1 @@
+"""Reporting: figures (each returns a matplotlib Figure), tables and the HTML report."""

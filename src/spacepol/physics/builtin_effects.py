@@ -121,9 +121,12 @@ class Smith(Effect):
         "the paper's empirical `shadowing`; darkens grazing geometries, DOP of the lobe unchanged."
     )
 
+    # Exact Lambda; renderers use Walter et al.'s rational fit (facets.smith_g1_beckmann_walter).
+    beckmann_g1 = staticmethod(facets.smith_g1_beckmann)
+
     def specular_factor(self, ctx):
         geo = ctx.geometry
-        g1 = facets.smith_g1_ggx if ctx.facet_shape == "ggx" else facets.smith_g1_beckmann
+        g1 = facets.smith_g1_ggx if ctx.facet_shape == "ggx" else self.beckmann_g1
         tan_i = np.sqrt(1.0 - geo.cos_ti**2) / geo.cos_ti
         tan_r = np.sqrt(1.0 - geo.cos_tr**2) / geo.cos_tr
         if ctx.anisotropic_slopes is not None:

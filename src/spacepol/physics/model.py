@@ -48,8 +48,14 @@ def _dop(stokes):
 
 class Model:
     def __init__(self, effects):
-        self.effects: list[Effect] = [e() if isinstance(e, type) else e for e in effects]
+        self.effects: list[Effect] = [self._instance(e) for e in effects]
         self._check()
+
+    @staticmethod
+    def _instance(effect) -> Effect:
+        if isinstance(effect, str):
+            effect = registry.get(effect)
+        return effect() if isinstance(effect, type) else effect
 
     @classmethod
     def from_string(cls, spec: str) -> "Model":

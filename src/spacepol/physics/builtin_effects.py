@@ -201,7 +201,14 @@ class Depolarization(Effect):
     )
 
     def modify_specular(self, ctx, lobe):
-        lobe[1:] *= 1.0 - ctx["d_spec"]
+        d = ctx["d_spec"]
+        if ctx.mueller:
+            # (1 - d) M + d M00 diag(1,0,0,0): the depolarized share keeps its intensity for any input.
+            m00 = lobe[0, 0].copy()
+            lobe *= 1.0 - d
+            lobe[0, 0] += d * m00
+        else:
+            lobe[1:] *= 1.0 - d
         return lobe
 
 
@@ -283,8 +290,10 @@ class Extinction(Effect):
     description = (
         "An imperfect analyser (finite extinction ratio) sees S1, S2, S3 scaled by e, so the measured "
         "DOP is e times the true one at every angle; intensity unchanged. On DOP and BRDF data it is a "
-        "twin of `depolarization` wherever the diffuse light is unpolarized."
+        "twin of `depolarization` wherever the diffuse light is unpolarized. An instrument effect on the "
+        "detector side, so the measured Mueller matrix is not reciprocal."
     )
+    reciprocal = False
 
     def modify_stokes(self, ctx, total):
         total[1:] *= ctx["e"]

@@ -87,6 +87,8 @@ class Geometry:
         k_i = np.stack([np.sin(ti), zeros, np.cos(ti)], axis=-1)
         k_r = np.stack([np.sin(tr) * np.cos(phi_r), np.sin(tr) * np.sin(phi_r), np.cos(tr)], axis=-1)
         self.k_i, self.k_r = k_i, k_r
+        # A source or detector pushed below the horizon (e.g. by angle_offset) sees nothing.
+        self.visible = (k_i[..., 2] > 0) & (k_r[..., 2] > 0)
         self.cos_ti = np.maximum(k_i[..., 2], _TINY)
         self.cos_tr = np.maximum(k_r[..., 2], _TINY)
 

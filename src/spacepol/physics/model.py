@@ -171,6 +171,7 @@ class Model:
                 total = total + extra
         for e in self.effects:
             total = e.modify_stokes(ctx, total)
+        total = np.where(geo.visible, total, 0.0)
         total = np.broadcast_to(total, total.shape[: 2 if mueller else 1] + shape).copy()
         stokes = total[:, 0] if mueller else total
         dop = _dop(stokes)

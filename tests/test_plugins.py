@@ -1,0 +1,88 @@
+"""A user's own effect works by name: loaded from a file or through the entry-point group."""
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spacepol.errors import ParameterError, SpacepolError
+from spacepol.physics import Geometry, Model
+from spacepol.physics.registry import Registry
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "user_effects.py"
+
+
+def test_file_plugin_composes_by_name():
+    reg = Registry()
+    for cls in __import__("spacepol.physics.builtin_effects", fromlist=["x"]).BUILTIN_EFFECTS:
+        reg.register(cls)
+    surge = reg.load_file(f"{EXAMPLE}:OppositionSurge")
+    assert reg.get("opposition_surge") is surge
+    model = Model([reg.get(n) for n in ["specular", "shadowing", "body"]] + [surge])
+    assert [p.name for p in model.free_parameters][-2:] == ["b0", "h_deg"]
+    g = Geometry(np.array([30.0, 30.0]), np.array([30.0, 60.0]), np.array([0.0, 0.0]))  # retro, off-retro
+    base = Model.from_string("paper").evaluate({}, g)
+    with_surge = model.evaluate({"b0": 0.2, "h_deg": 5.0}, g)
+    assert with_surge.brdf[0] - base.brdf[0] == pytest.approx(0.2)
+    assert with_surge.brdf[1] - base.brdf[1] == pytest.approx(0.2 * np.exp(-30 / 5.0))
+    assert np.all(with_surge.dop < base.dop + 1e-15)  # unpolarized light only dilutes
+
+
+def test_decorated_function_plugin():
+    reg = Registry()
+    scale = reg.load_file(f"{EXAMPLE}:DopScaleError")
+    assert scale.name == "dop_scale_error"
+    g = Geometry(np.array([40.0]), np.array([40.0]), np.array([180.0]))
+    base = Model.from_string("paper").evaluate({}, g).dop
+    scaled = (Model.from_string("paper") + scale).evaluate({"gain": 0.9}, g).dop
+    assert scaled[0] == pytest.approx(0.9 * base[0])
+
+
+def test_entry_point_plugin(tmp_path, monkeypatch):
+    pkg = tmp_path / "my_optics_effects.py"
+    pkg.write_text(EXAMPLE.read_text())
+    dist = tmp_path / "my_optics-0.1.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: my-optics\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text("[spacepol.effects]\nopposition_surge = my_optics_effects:OppositionSurge\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    reg = Registry()
+    assert "opposition_surge" in reg.names()
+    assert reg.get("opposition_surge").__name__ == "OppositionSurge"
+
+
+def test_parameter_collision_raises():
+    from spacepol.physics.effects import Effect, Parameter
+    from spacepol.infer.priors import Uniform
+
+    class Clash(Effect):
+        name = "clash"
+        parameters = (Parameter("sigma", "", Uniform(0, 1), 0.1, "duplicate name"),)
+
+    with pytest.raises(ParameterError, match="collides"):
+        Model.from_string("specular") + Clash()
+
+
+def test_composition_rules():
+    with pytest.raises(SpacepolError, match="replaces"):
+        Model.from_string("specular+shadowing+smith")
+    with pytest.raises(SpacepolError, match="needs 'specular'"):
+        Model.from_string("body+shadowing")
+    with pytest.raises(SpacepolError, match="unknown effect 'glitter'"):
+        Model.from_string("paper+glitter")
+    assert (Model.from_string("specular") + "body").name == "specular+body"
+    assert "sigma" not in [p.name for p in Model.from_string("specular+anisotropy").parameters]
+
+
+def test_cli_effect_option_makes_the_name_usable(tmp_path):
+    out = tmp_path / "synth.csv"
+    cmd = [sys.executable, "-m", "spacepol.cli", "--effect", f"{EXAMPLE}:OppositionSurge", "synth",
+           "--model", "paper+opposition_surge", "--set", "b0=0.3", "--out", str(out)]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    listing = subprocess.run([sys.executable, "-m", "spacepol.cli", "--effect", f"{EXAMPLE}:OppositionSurge", "effects"],
+                             capture_output=True, text=True)
+    assert "opposition_surge" in listing.stdout and "b0 [sr^-1]" in listing.stdout

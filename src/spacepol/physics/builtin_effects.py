@@ -61,9 +61,14 @@ class Specular(Effect):
         # and modify_specular hooks before it is added), see specular_lobe().
         return None
 
-    def specular_lobe(self, ctx: Context):
+    def specular_lobe(self, ctx: Context, factor=None):
+        """The lobe times ``factor`` (the product of the shadowing factors, or None)."""
         geo = ctx.geometry
+        if not ctx.mueller and self._fast_path_applies(ctx):
+            return self._fast_stokes(ctx, factor)
         scalar = ctx["ks"] * self.distribution(ctx) * geo.specular_jacobian
+        if factor is not None:
+            scalar = scalar * factor
         if ctx.mueller:
             if ctx.fresnel_amplitudes is not None:
                 r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
@@ -81,6 +86,27 @@ class Specular(Effect):
         half_diff = 0.5 * scalar * (big_rs - big_rp)
         s0 = 0.5 * scalar * (big_rs + big_rp)
         return np.array(np.broadcast_arrays(s0, half_diff * geo.cos_2eta_r, -half_diff * geo.sin_2eta_r, np.zeros_like(s0)))
+
+    @staticmethod
+    def _fast_path_applies(ctx):
+        """The compiled kernel covers isotropic facets, bulk Fresnel and a geometry fixed per data set."""
+        return ctx.anisotropic_slopes is None and ctx.fresnel_amplitudes is None and ctx.geometry.theta_i.ndim == 1
+
+    def _fast_stokes(self, ctx, factor):
+        from . import kernels
+
+        geo = ctx.geometry
+        n_sets = ctx.shape[0] if len(ctx.shape) == 2 else 1
+        sets = [kernels.as_sets(ctx[name], n_sets) for name in ("n", "k", "sigma", "ks")]
+        if factor is None:
+            factor = np.ones((1, geo.size))
+        factor = np.ascontiguousarray(np.atleast_2d(np.broadcast_to(factor, np.broadcast_shapes(np.shape(factor), (geo.size,)))))
+        terms = geo.cached("specular_kernel_terms", lambda: tuple(
+            np.ascontiguousarray(t) for t in (geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta, geo.tan2_alpha,
+                                              geo.sec4_alpha * geo.specular_jacobian, geo.cos_2eta_r, geo.sin_2eta_r)))
+        out = np.empty((4, n_sets, geo.size))
+        kernels.specular_stokes(*sets, *terms, factor, ctx.facet_shape == "ggx", out)
+        return out if len(ctx.shape) == 2 else out[:, 0]
 
 
 class Shadowing(Effect):
@@ -154,7 +180,7 @@ class Body(Effect):
     )
 
     def lobe(self, ctx):
-        return ctx.depolarized(ctx["rho_d"] * ctx.geometry.cos_tr / np.pi)
+        return ctx.depolarized((ctx["rho_d"] / np.pi) * ctx.geometry.cos_tr)
 
 
 class PolarizedDiffuse(Effect):

@@ -15,7 +15,8 @@ this order for every effect of the model:
 
 Lobes are arrays of shape (4, *shape) (the Stokes vector for unpolarized incidence) or
 (4, 4, *shape) (the Mueller matrix, when the caller asks for it): row operations such as
-``lobe[1:] *= f`` work on both.  ``ctx.depolarized(f)`` builds a lobe that only scatters intensity.
+``lobe[1:] *= f`` work on both.  ``lobe`` may also return ``ctx.depolarized(f)``, a lobe that
+only scatters intensity (stored as its S0 alone).
 """
 
 from __future__ import annotations
@@ -49,14 +50,9 @@ class Context:
         lead = (4, 4) if self.mueller else (4,)
         return np.zeros(lead + self.shape)
 
-    def depolarized(self, value):
+    def depolarized(self, value) -> "DepolarizedLobe":
         """A lobe whose light is unpolarized with intensity ``value`` (Mueller diag(1,0,0,0))."""
-        out = self.zeros()
-        if self.mueller:
-            out[0, 0] = value
-        else:
-            out[0] = value
-        return out
+        return DepolarizedLobe(value)
 
     def first_column_times_row(self, column, row):
         """Lobe of a Mueller matrix column (x) row: ``row`` is applied to the incident Stokes vector.
@@ -73,6 +69,20 @@ class Context:
             for i in range(4):
                 out[i] = column[i] * row[0]
         return out
+
+
+@dataclass
+class DepolarizedLobe:
+    """An additive lobe of unpolarized light: only S0 (M00) is non-zero, so only it is stored."""
+
+    intensity: np.ndarray
+
+    def add_to(self, total, mueller: bool):
+        if mueller:
+            total[0, 0] += self.intensity
+        else:
+            total[0] += self.intensity
+        return total
 
 
 class Effect:

@@ -89,6 +89,7 @@ class Geometry:
         self.k_i, self.k_r = k_i, k_r
         # A source or detector pushed below the horizon (e.g. by angle_offset) sees nothing.
         self.visible = (k_i[..., 2] > 0) & (k_r[..., 2] > 0)
+        self.all_visible = bool(np.all(self.visible))
         self.cos_ti = np.maximum(k_i[..., 2], _TINY)
         self.cos_tr = np.maximum(k_r[..., 2], _TINY)
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import ParameterError, UnknownNameError
 from .builtin_effects import Specular
-from .effect import Context, Effect
+from .effect import Context, DepolarizedLobe, Effect
 from .geometry import Geometry
 from .parameter import Parameter
 from .registry import registry
@@ -38,6 +38,12 @@ class Prediction:
 
 
 def _dop(stokes):
+    if stokes.ndim == 3 and stokes.dtype == np.float64:
+        from .kernels import stokes_dop
+
+        out = np.empty(stokes.shape[1:])
+        stokes_dop(np.ascontiguousarray(stokes), out)
+        return out
     s0 = stokes[0]
     pol = np.sqrt(stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2)
     out = np.zeros_like(s0)
@@ -154,25 +160,31 @@ class Model:
         for e in self.effects:
             e.configure(ctx)
 
-        total = ctx.zeros()
         specular = next((e for e in self.effects if isinstance(e, Specular)), None)
         if specular is not None:
-            lobe = specular.specular_lobe(ctx)
+            factor = None
             for e in self.effects:
-                factor = e.specular_factor(ctx)
-                if factor is not None:
-                    lobe = lobe * factor
+                f = e.specular_factor(ctx)
+                if f is not None:
+                    factor = f if factor is None else factor * f
+            total = specular.specular_lobe(ctx, factor)
             for e in self.effects:
-                lobe = e.modify_specular(ctx, lobe)
-            total = total + lobe
+                total = e.modify_specular(ctx, total)
+        else:
+            total = ctx.zeros()
+        lead = (4, 4) if mueller else (4,)
+        if total.shape != lead + shape:
+            total = np.broadcast_to(total, lead + shape).copy()
         for e in self.effects:
             extra = e.lobe(ctx)
-            if extra is not None:
-                total = total + extra
+            if isinstance(extra, DepolarizedLobe):
+                total = extra.add_to(total, mueller)
+            elif extra is not None:
+                total += extra
         for e in self.effects:
             total = e.modify_stokes(ctx, total)
-        total = np.where(geo.visible, total, 0.0)
-        total = np.broadcast_to(total, total.shape[: 2 if mueller else 1] + shape).copy()
+        if not geo.all_visible:
+            total = np.where(geo.visible, total, 0.0)
         stokes = total[:, 0] if mueller else total
         dop = _dop(stokes)
         for e in self.effects:

@@ -39,7 +39,34 @@ def _parser() -> argparse.ArgumentParser:
 
     sub.add_parser("effects", help="list every registered effect: parameters, priors, units, physics")
 
-    for name in ("run", "optimize", "compare", "diagnose", "ladder", "sky", "contrast"):
+    def data_options(p):
+        p.add_argument("data", help="measurement file (spacepol CSV or NIST Mueller BRDF)")
+        p.add_argument("--model", default="paper")
+        p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
+        p.add_argument("--wavelength-um", type=float, help="select one wavelength of a multi-wavelength file")
+        p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
+        p.add_argument("--observables", help="comma-separated subset of dop,brdf (default: all in the file)")
+        p.add_argument("--seed", type=int, default=0)
+
+    p = sub.add_parser("run", help="emcee posterior with corner, fit and residual plots and a report")
+    data_options(p)
+    p.add_argument("--walkers", type=int, default=None)
+    p.add_argument("--steps", type=int, default=20000, help="cap on the chain length (steps)")
+    p.add_argument("--robust", action="store_true", help="Student-t likelihood (nu = 4) instead of Gaussian")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--out", default="reports/run")
+
+    p = sub.add_parser("optimize", help="one optimizer's best fit as JSON on stdout")
+    data_options(p)
+    p.add_argument("--method", required=True, help="ga, de, emcee, or nlopt:ALGO")
+
+    p = sub.add_parser("compare", help="every optimizer, several seeds, against the posterior")
+    data_options(p)
+    p.add_argument("--methods", nargs="+", default=None)
+    p.add_argument("--seeds", type=int, default=3, help="runs per method")
+    p.add_argument("--out", default="reports/compare")
+
+    for name in ("diagnose", "ladder", "sky", "contrast"):
         p = sub.add_parser(name, help="(not yet available)")
         p.add_argument("rest", nargs=argparse.REMAINDER)
     return parser

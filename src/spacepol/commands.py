@@ -126,8 +126,88 @@ def demo(args) -> int:
     return 0
 
 
+def load_dataset(args) -> Dataset:
+    data = read_measurements(args.data)
+    if data.wavelength_um is not None and len(np.unique(data.wavelength_um)) > 1:
+        if args.wavelength_um is None:
+            have = ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))
+            raise SpacepolError(f"{args.data}: holds several wavelengths ({have} um); choose one with --wavelength-um")
+    if args.wavelength_um is not None:
+        data = data.at_wavelength(args.wavelength_um)
+    if args.in_plane:
+        data = data.in_plane()
+    return data
+
+
+def build_posterior(args, data, robust=False):
+    from .infer.posterior import Posterior
+    from .infer.prior_set import read_prior_file
+
+    model = build_model(args.model)
+    overrides = read_prior_file(args.prior) if args.prior else None
+    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    return Posterior.build(data, model, overrides, observables=observables, robust=robust,
+                           where=args.prior or "priors")
+
+
+def run(args) -> int:
+    from .infer.inversion import invert
+    from .report.run_report import write_run_report
+
+    if args.steps < 100:
+        raise ParameterError(f"--steps {args.steps}: need at least 100")
+    data = load_dataset(args)
+    posterior = build_posterior(args, data, robust=args.robust)
+    out = Path(args.out)
+    if not args.quiet:
+        print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
+              f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}", file=sys.stderr)
+    out.mkdir(parents=True, exist_ok=True)
+    inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,
+                 backend_path=out / "chain.h5", progress=not args.quiet)
+    summary = write_run_report(inv, out, args.data)
+    d = summary["diagnostics"]
+    print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, report.html "
+          f"(R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")
+    return 0
+
+
+def optimize(args) -> int:
+    import json
+
+    from .infer.engines import optimize as run_optimizer
+    from .infer.objective import PaperObjective
+    from .infer.prior_set import PriorSet
+    from .io.atomic import _jsonable
+
+    data = load_dataset(args)
+    if args.method == "emcee":
+        from .infer.inversion import invert
+
+        inv = invert(build_posterior(args, data), seed=args.seed, progress=False)
+        result = inv.result
+    else:
+        posterior = build_posterior(args, data)
+        model = posterior.likelihood.model
+        model_priors = PriorSet(model.parameters, {n: posterior.priors.priors[n] for n in posterior.priors.priors
+                                                   if n in {p.name for p in model.parameters}})
+        result = run_optimizer(args.method, PaperObjective(data, model, model_priors),
+                               np.random.default_rng(args.seed), model.name, seed=args.seed)
+    print(json.dumps(_jsonable(result.to_json()), indent=2))
+    return 0
+
+
+def compare(args) -> int:
+    from .report.compare import run_comparison
+
+    data = load_dataset(args)
+    posterior = build_posterior(args, data)
+    run_comparison(posterior, data, Path(args.out), methods=args.methods, seeds=args.seeds, base_seed=args.seed)
+    return 0
+
+
 def _not_yet(args) -> int:
     raise SpacepolError(f"'{args.command}' is not available yet in this version")
 
 
-run = optimize = compare = diagnose = ladder = sky = contrast = _not_yet
+diagnose = ladder = sky = contrast = _not_yet

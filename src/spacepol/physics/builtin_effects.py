@@ -99,8 +99,11 @@ class Specular(Effect):
         n_sets = ctx.shape[0] if len(ctx.shape) == 2 else 1
         sets = [kernels.as_sets(ctx[name], n_sets) for name in ("n", "k", "sigma", "ks")]
         if factor is None:
-            factor = np.ones((1, geo.size))
-        factor = np.ascontiguousarray(np.atleast_2d(np.broadcast_to(factor, np.broadcast_shapes(np.shape(factor), (geo.size,)))))
+            factor = geo.cached("unit_factor", lambda: np.ones((1, geo.size)))
+        elif factor.ndim == 1:
+            factor = factor.reshape(1, -1)
+        else:
+            factor = np.ascontiguousarray(np.broadcast_to(factor, (factor.shape[0], geo.size)))
         terms = geo.cached("specular_kernel_terms", lambda: tuple(
             np.ascontiguousarray(t) for t in (geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta, geo.tan2_alpha,
                                               geo.sec4_alpha * geo.specular_jacobian, geo.cos_2eta_r, geo.sin_2eta_r)))
@@ -130,9 +133,11 @@ class Shadowing(Effect):
 
     def specular_factor(self, ctx):
         params = [ctx[name] for name in PAPER_CONSTANTS]
-        if all(np.ndim(v) == 0 for v in params):
-            key = ("paper_shadowing",) + tuple(float(v) for v in params)
-            return ctx.geometry.cached(key, lambda: paper_shadowing(ctx.geometry, *params))
+        constant = all(np.ndim(v) == 0 or np.all(v == np.asarray(v).flat[0]) for v in params)
+        if ctx.geometry.theta_i.ndim == 1 and constant:
+            # the usual case: constants fixed, so G is a geometry-only term computed once
+            values = tuple(float(np.asarray(v).flat[0]) for v in params)
+            return ctx.geometry.cached(("paper_shadowing",) + values, lambda: paper_shadowing(ctx.geometry, *values))
         return paper_shadowing(ctx.geometry, *params)
 
 

@@ -75,5 +75,7 @@ def stokes_dop(stokes, out):
 
 def as_sets(value, n_sets):
     """A parameter as a contiguous (P,) float array."""
-    arr = np.asarray(value, dtype=float).reshape(-1)
-    return np.ascontiguousarray(np.broadcast_to(arr, (n_sets,)))
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0 or arr.size == 1:
+        return np.full(n_sets, float(arr.flat[0]))
+    return np.ascontiguousarray(arr.reshape(-1))

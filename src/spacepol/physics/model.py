@@ -103,6 +103,7 @@ class Model:
         self._owner = owner
         removed = {r for e in self.effects for r in e.removes}
         self._parameters = [p for e in self.effects for p in e.parameters if p.name not in removed]
+        self._names = {p.name for p in self._parameters}
 
     @property
     def parameters(self) -> list[Parameter]:
@@ -128,21 +129,26 @@ class Model:
         return {p.name: p.default for p in self._parameters}
 
     def _resolve(self, params: dict, check: bool = True) -> tuple[dict, tuple]:
-        known = {p.name for p in self._parameters}
-        unknown = sorted(set(params) - known)
-        if unknown:
+        if not self._names.issuperset(params):
+            unknown = sorted(set(params) - self._names)
             raise UnknownNameError(
-                f"model '{self.name}' has no parameter(s) {', '.join(unknown)} (it has: {', '.join(sorted(known))})"
+                f"model '{self.name}' has no parameter(s) {', '.join(unknown)} (it has: {', '.join(sorted(self._names))})"
             )
-        values = {p.name: np.asarray(params.get(p.name, p.default), dtype=float) for p in self._parameters}
-        if check:
-            for p in self._parameters:
-                p.check(values[p.name], where=f"model '{self.name}'")
-        batch = np.broadcast_shapes(*(v.shape for v in values.values())) if values else ()
-        if len(batch) > 1:
-            raise ParameterError("parameter values must be scalars or 1-d arrays (one entry per parameter set)")
-        # (P,) -> (P, 1) so parameter sets broadcast against the N geometries.
-        return {k: (v[..., None] if v.ndim else v) for k, v in values.items()}, batch
+        values, batch = {}, ()
+        for p in self._parameters:
+            v = params.get(p.name, p.default)
+            if check:
+                p.check(v, where=f"model '{self.name}'")
+            if np.ndim(v) == 0:
+                values[p.name] = float(v)
+                continue
+            v = np.asarray(v, dtype=float)
+            if v.ndim > 1 or (batch and v.shape != batch and v.shape != (1,)):
+                raise ParameterError("parameter values must be scalars or 1-d arrays of one length (one entry per parameter set)")
+            batch = batch if (batch and v.shape == (1,)) else v.shape
+            # (P,) -> (P, 1) so parameter sets broadcast against the N geometries.
+            values[p.name] = v[:, None]
+        return values, batch
 
     def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
         """Evaluate for parameter sets (scalars or arrays of length P) at N geometries.

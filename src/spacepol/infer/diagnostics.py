@@ -1,0 +1,71 @@
+"""Convergence and fit diagnostics (ArviZ for R-hat, ESS and PSIS-LOO)."""
+
+from __future__ import annotations
+
+import warnings
+
+import arviz as az
+import numpy as np
+
+from .inference_data import noise_scales, predictive_means
+from .posterior import Posterior
+from .result import Result
+
+
+def convergence(idata, result: Result) -> dict:
+    rhat = az.rhat(idata)
+    ess_bulk = az.ess(idata, method="bulk")
+    ess_tail = az.ess(idata, method="tail")
+    names = list(idata.posterior.data_vars)
+    return {
+        "rhat_max": float(max(rhat[n].item() for n in names)),
+        "ess_min": float(min(min(ess_bulk[n].item(), ess_tail[n].item()) for n in names)),
+        "ess_bulk_min": float(min(ess_bulk[n].item() for n in names)),
+        "ess_tail_min": float(min(ess_tail[n].item() for n in names)),
+        "tau_max": float(result.info.get("tau_max", np.nan)),
+        "acceptance": float(result.info.get("acceptance", np.nan)),
+        "per_parameter": {n: {"rhat": float(rhat[n].item()), "ess_bulk": float(ess_bulk[n].item()),
+                              "ess_tail": float(ess_tail[n].item())} for n in names},
+    }
+
+
+def loo(idata) -> dict:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = az.loo(idata, pointwise=True, var_name="y")
+    k = np.asarray(res.pareto_k)
+    labels = list(idata.log_likelihood["obs_id"].values)
+    bad = [labels[i] for i in np.flatnonzero(k > 0.7)]
+    return {"elpd_loo": float(res.elpd_loo), "elpd_loo_se": float(res.se), "p_loo": float(res.p_loo),
+            "pareto_k": k, "pareto_k_bad": bad, "pointwise": np.asarray(res.loo_i)}
+
+
+def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:
+    """RMSE of DOP and reduced chi^2 at the posterior-median prediction."""
+    flat = result.flat_samples()
+    means = predictive_means(posterior, flat)
+    scales = noise_scales(posterior, flat)
+    lik = posterior.likelihood
+    chi2, rmse = 0.0, None
+    for o in lik.observables:
+        y, mu = getattr(lik.data, o), np.median(means[o], axis=0)
+        scale = np.median(scales[o], axis=0)
+        if o == "brdf" and lik.data.brdf_err is None:
+            resid = np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))
+        else:
+            resid = y - mu
+        chi2 += float(np.sum((resid / scale) ** 2))
+        if o == "dop":
+            rmse = float(np.sqrt(np.mean((y - mu) ** 2)))
+    dof = max(lik.n_obs - posterior.ndim, 1)
+    return {"rmse_dop": rmse, "chi2_red": chi2 / dof, "elpd_loo": loo_result["elpd_loo"],
+            "elpd_loo_se": loo_result["elpd_loo_se"]}
+
+
+def quantiles(result: Result) -> dict:
+    flat = result.flat_samples()
+    out = {}
+    for j, name in enumerate(result.names):
+        q = np.percentile(flat[:, j], [5, 16, 50, 84, 95])
+        out[name] = {"median": float(q[2]), "q05": float(q[0]), "q16": float(q[1]), "q84": float(q[3]), "q95": float(q[4])}
+    return out

@@ -1,0 +1,55 @@
+"""nlopt's global algorithms on the prior cube."""
+
+from __future__ import annotations
+
+import time
+
+import nlopt
+import numpy as np
+
+from ...errors import UnknownNameError
+from ..result import History, Result
+
+NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
+
+
+def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: str = "",
+              max_evaluations: int = 20000, ftol_rel: float = 1e-10, seed: int | None = None) -> Result:
+    code = getattr(nlopt, algorithm, None)
+    if code is None or not algorithm.startswith("G"):
+        raise UnknownNameError(f"unknown nlopt global algorithm '{algorithm}' (try {', '.join(NLOPT_ALGORITHMS)})")
+    start = time.perf_counter()
+    priors, ndim = objective.priors, objective.priors.ndim
+    history = History()
+    nlopt.srand(int(rng.integers(2**31)))
+    opt = nlopt.opt(code, ndim)
+    opt.set_lower_bounds([0.0] * ndim)
+    opt.set_upper_bounds([1.0] * ndim)
+    if algorithm.startswith("GN_MLSL") or algorithm.startswith("G_MLSL"):
+        local = nlopt.opt(nlopt.LN_BOBYQA, ndim)
+        local.set_ftol_rel(1e-8)
+        local.set_maxeval(max(200, max_evaluations // 50))
+        opt.set_local_optimizer(local)
+    opt.set_maxeval(max_evaluations)
+    opt.set_ftol_rel(ftol_rel)
+
+    def f(u, grad):
+        theta = priors.rescale(np.clip(np.asarray(u), 0, 1)[None, :])
+        value = float(objective(theta)[0])
+        history.record(theta, [value])
+        return value
+
+    opt.set_min_objective(f)
+    x0 = rng.uniform(0.2, 0.8, ndim)
+    try:
+        opt.optimize(x0)
+        status = opt.last_optimize_result()
+    except (nlopt.RoundoffLimited, RuntimeError) as exc:  # keep the best point found so far
+        status = f"stopped: {type(exc).__name__}"
+    return Result(
+        method=f"nlopt:{algorithm}", model=model_name, names=list(objective.names),
+        best=dict(zip(objective.names, map(float, history.best_x))), objective=history.best,
+        objective_name=objective.name, n_evaluations=history.evaluations,
+        seconds=time.perf_counter() - start, seed=-1 if seed is None else seed, history=history.as_array(),
+        info={"status": str(status)},
+    )

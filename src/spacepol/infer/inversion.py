@@ -1,0 +1,94 @@
+"""A full Bayesian inversion: posterior -> emcee -> InferenceData -> diagnostics -> summary."""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from ..errors import SpacepolError
+from .diagnostics import convergence, fit_statistics, loo, quantiles
+from .engines.emcee_sampler import default_walkers, sample_emcee
+from .identifiability import identifiability
+from .inference_data import to_inference_data
+from .posterior import Posterior
+from .result import Result
+
+
+@dataclass
+class Inversion:
+    posterior: Posterior
+    result: Result
+    idata: object
+    summary: dict
+    loo: dict
+    identifiability: dict
+
+
+def fingerprint(posterior: Posterior, walkers: int, seed: int) -> str:
+    lik = posterior.likelihood
+    h = hashlib.sha256()
+    h.update(lik.model.name.encode())
+    h.update(repr(sorted(posterior.priors.describe().items())).encode())
+    h.update(repr(lik.observables).encode())
+    h.update(np.ascontiguousarray(np.column_stack([lik.data.theta_i, lik.data.theta_r, lik.data.dphi])).tobytes())
+    for o in lik.observables:
+        h.update(np.ascontiguousarray(getattr(lik.data, o)).tobytes())
+    h.update(f"{walkers}:{seed}".encode())
+    return h.hexdigest()[:16]
+
+
+def _check_backend(path: Path, print_: str) -> None:
+    if not path.exists():
+        return
+    with h5py.File(path, "r") as f:
+        stored = f.attrs.get("spacepol_fingerprint")
+    if stored is not None and stored != print_:
+        raise SpacepolError(f"{path}: holds the chain of a different run (model, data, priors, walkers or seed); "
+                            f"delete it or use another --out")
+
+
+def _stamp_backend(path: Path, print_: str) -> None:
+    with h5py.File(path, "a") as f:
+        f.attrs["spacepol_fingerprint"] = print_
+
+
+def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
+           backend_path=None, progress: bool = True, check_every: int = 500) -> Inversion:
+    start = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    walkers = walkers or default_walkers(posterior.ndim)
+    if walkers < 2 * posterior.ndim or walkers % 2:
+        raise SpacepolError(f"--walkers {walkers}: need an even number >= 2 x {posterior.ndim} parameters")
+    if backend_path is not None:
+        backend_path = Path(backend_path)
+        print_ = fingerprint(posterior, walkers, seed)
+        _check_backend(backend_path, print_)
+    result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
+                          progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
+                          check_every=check_every)
+    if backend_path is not None:
+        _stamp_backend(backend_path, print_)
+    idata = to_inference_data(result, posterior, rng)
+    loo_result = loo(idata)
+    summary = {
+        "model": posterior.likelihood.model.name,
+        "parameters": quantiles(result),
+        "diagnostics": convergence(idata, result),
+        "fit": fit_statistics(posterior, result, loo_result),
+        "seconds": time.perf_counter() - start,
+        "seed": seed,
+        "observables": posterior.likelihood.observables,
+        "n_observations": posterior.likelihood.n_obs,
+        "priors": posterior.priors.describe(),
+        "map": result.best,
+        "sampler": {k: v for k, v in result.info.items() if k != "tau"} | {"tau": result.info.get("tau")},
+        "pareto_k_bad": loo_result["pareto_k_bad"],
+    }
+    ident = identifiability(posterior, result)
+    summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "findings", "width_ratio")}
+    return Inversion(posterior, result, idata, summary, loo_result, ident)

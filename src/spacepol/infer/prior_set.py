@@ -1,0 +1,148 @@
+"""The joint prior over a model's free parameters (and the likelihood's nuisance parameters).
+
+Defaults come from each effect's ``Parameter``; a TOML file overrides them::
+
+    [n]                      # a parameter's table
+    distribution = "uniform" # uniform | loguniform | normal (truncated to [lower, upper])
+    lower = 1.0
+    upper = 2.0
+
+    [k]
+    fixed = 0.0              # hold at a value
+
+    [sigma_p]                # free a parameter that is fixed by default
+    distribution = "uniform"
+    lower = 0.0
+    upper = 0.1
+
+The parameter vector ``theta`` (shape (W, D)) lists the free parameters in model order; the
+unit cube u in [0, 1]^D maps to theta through each prior's inverse CDF (``rescale``), so the
+GA, nlopt and differential evolution search the very space the sampler sees.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError, SpacepolError
+from ..physics.parameter import Parameter
+from .priors import Fixed, LogUniform, Prior, TruncatedNormal, Uniform
+
+_KEYS = {"distribution", "lower", "upper", "mu", "sigma", "fixed"}
+
+
+def prior_from_table(name: str, table: dict, where: str) -> Prior:
+    unknown = set(table) - _KEYS
+    if unknown:
+        raise ParameterError(f"{where}: [{name}] has unknown key(s) {', '.join(sorted(unknown))} (allowed: {', '.join(sorted(_KEYS))})")
+    if "fixed" in table:
+        if len(table) > 1:
+            raise ParameterError(f"{where}: [{name}] 'fixed' cannot be combined with other keys")
+        return Fixed(_float(table["fixed"], name, "fixed", where))
+    kind = table.get("distribution", "uniform")
+    try:
+        lower = _float(table["lower"], name, "lower", where)
+        upper = _float(table["upper"], name, "upper", where)
+    except KeyError as missing:
+        raise ParameterError(f"{where}: [{name}] needs {missing.args[0]}") from None
+    try:
+        if kind == "uniform":
+            return Uniform(lower, upper)
+        if kind == "loguniform":
+            return LogUniform(lower, upper)
+        if kind == "normal":
+            return TruncatedNormal(_float(table.get("mu"), name, "mu", where), _float(table.get("sigma"), name, "sigma", where), lower, upper)
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: [{name}] {exc}") from None
+    raise ParameterError(f"{where}: [{name}] unknown distribution '{kind}' (uniform, loguniform, normal)")
+
+
+def _float(value, name, key, where):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(f"{where}: [{name}] {key} must be a number, got {value!r}")
+    return float(value)
+
+
+def read_prior_file(path) -> dict[str, Prior]:
+    path = Path(path)
+    if not path.is_file():
+        raise SpacepolError(f"{path}: prior file not found")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SpacepolError(f"{path}: not valid TOML ({exc})") from None
+    priors = {}
+    for name, table in data.items():
+        if not isinstance(table, dict):
+            raise ParameterError(f"{path}: '{name}' must be a table [{name}]")
+        priors[name] = prior_from_table(name, table, str(path))
+    return priors
+
+
+class PriorSet:
+    """Priors of every parameter: free ones in ``names`` order, fixed ones held in ``fixed``."""
+
+    def __init__(self, parameters: list[Parameter], overrides: dict[str, Prior] | None = None, where: str = "priors"):
+        overrides = dict(overrides or {})
+        known = {p.name for p in parameters}
+        unknown = sorted(set(overrides) - known)
+        if unknown:
+            raise ParameterError(f"{where}: no parameter(s) {', '.join(unknown)} in this model (it has {', '.join(sorted(known))})")
+        self.parameters = list(parameters)
+        self.priors: dict[str, Prior] = {}
+        for p in parameters:
+            prior = overrides.get(p.name, p.effective_prior)
+            lo, hi = p.physical
+            if prior.lower < lo or prior.upper > hi:
+                raise ParameterError(
+                    f"{where}: prior {prior} of {p.name} reaches outside its physical range [{lo:g}, {hi:g}]"
+                )
+            self.priors[p.name] = prior
+        self.names = [n for n, pr in self.priors.items() if not pr.is_fixed]
+        free = [self.priors[n] for n in self.names]
+        # Fast path of ln_prob when every free prior is uniform (the common case, and the hot path).
+        self._all_uniform = all(type(pr) is Uniform for pr in free)
+        self._lower = np.array([pr.lower for pr in free])
+        self._upper = np.array([pr.upper for pr in free])
+        self._uniform_constant = -float(np.sum(np.log(self._upper - self._lower))) if self._all_uniform else 0.0
+        self.fixed = {n: pr.value for n, pr in self.priors.items() if pr.is_fixed}
+        if not self.names:
+            raise ParameterError(f"{where}: every parameter is fixed; nothing to infer")
+
+    @property
+    def ndim(self) -> int:
+        return len(self.names)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return np.array([self.priors[n].bounds for n in self.names])
+
+    def ln_prob(self, theta) -> np.ndarray:
+        theta = np.atleast_2d(theta)
+        if self._all_uniform:
+            inside = np.all((theta >= self._lower) & (theta <= self._upper), axis=1)
+            return np.where(inside, self._uniform_constant, -np.inf)
+        total = np.zeros(theta.shape[0])
+        for j, name in enumerate(self.names):
+            total = total + self.priors[name].ln_prob(theta[:, j])
+        return total
+
+    def rescale(self, u) -> np.ndarray:
+        u = np.atleast_2d(u)
+        return np.column_stack([self.priors[n].rescale(u[:, j]) for j, n in enumerate(self.names)])
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        return self.rescale(rng.uniform(size=(size, self.ndim)))
+
+    def to_params(self, theta) -> dict[str, np.ndarray]:
+        """theta (W, D) -> {name: (W,) array}, plus the fixed values as scalars."""
+        theta = np.atleast_2d(theta)
+        params = {name: theta[:, j] for j, name in enumerate(self.names)}
+        params.update(self.fixed)
+        return params
+
+    def describe(self) -> dict[str, str]:
+        return {name: str(prior) for name, prior in self.priors.items()}

@@ -1,0 +1,81 @@
+"""Files of ``invert-mcmc run``: summary.json, posterior.nc, corner.png, fit.png, residuals.png, report.html."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_path, save_figure, write_json
+from . import html as H
+from .inversion_figures import corner_figure, fit_figure, residual_figure
+
+
+def truths_from_metadata(metadata: dict) -> dict:
+    out = {}
+    for key, value in metadata.items():
+        if key.startswith("truth_"):
+            try:
+                out[key[6:]] = float(value)
+            except ValueError:
+                pass
+    return out
+
+
+def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = None) -> dict:
+    out.mkdir(parents=True, exist_ok=True)
+    posterior, result, summary = inv.posterior, inv.result, inv.summary
+    truths = truths_from_metadata(posterior.likelihood.data.metadata)
+    figures = {
+        "corner.png": corner_figure(result, truths),
+        "fit.png": fit_figure(posterior, result, "dop" if "dop" in posterior.likelihood.observables else "brdf"),
+        "residuals.png": residual_figure(posterior, result),
+    }
+    for name, fig in figures.items():
+        save_figure(fig, out / name)
+    with atomic_path(out / "posterior.nc") as tmp:
+        inv.idata.to_netcdf(str(tmp))
+    write_json(out / "summary.json", summary)
+    (out / "report.html").write_text(_html(inv, data_path, figures, truths, notes or []), encoding="utf-8")
+    return summary
+
+
+def _html(inv, data_path, figures, truths, notes) -> str:
+    s = inv.summary
+    diag, fit = s["diagnostics"], s["fit"]
+    rows = []
+    for name, q in s["parameters"].items():
+        truth = truths.get(name)
+        rows.append([name, f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
+                     f"{diag['per_parameter'][name]['rhat']:.4f}", f"{diag['per_parameter'][name]['ess_bulk']:.0f}",
+                     "" if truth is None else f"{truth:.4g}", s["priors"].get(name, "")])
+    converged = diag["rhat_max"] <= 1.01 and diag["ess_min"] >= 400 and not s["sampler"].get("capped")
+    verdict = ("Converged: R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
+               "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting the intervals.")
+    if s["sampler"].get("capped"):
+        verdict += f" The chain hit the step cap ({s['sampler']['steps']} steps) before reaching 50 autocorrelation times."
+    sections = [
+        ("Data and model", H.paragraph(
+            f"{data_path}: {s['n_observations']} observations ({', '.join(s['observables'])}); model {s['model']}; "
+            f"seed {s['seed']}; {s['seconds']:.1f} s.")),
+        ("Parameters", H.table(["parameter", "median", "90 % interval", "68 % interval", "R-hat", "ESS bulk", "truth", "prior"], rows)),
+        ("Convergence", H.paragraph(verdict) + H.table(
+            ["R-hat max", "ESS min (bulk/tail)", "tau max (steps)", "acceptance", "walkers", "steps", "burn-in", "thin"],
+            [[f"{diag['rhat_max']:.4f}", f"{diag['ess_min']:.0f}", f"{diag['tau_max']:.1f}", f"{diag['acceptance']:.2f}",
+              s["sampler"]["walkers"], s["sampler"]["steps"], s["sampler"]["burn_in"], s["sampler"]["thin"]]])),
+        ("What the data determine", H.bullets(s["identifiability"]["findings"])),
+        ("Fit", H.table(["RMSE (DOP)", "reduced chi^2", "ELPD-LOO", "SE"],
+                        [[_fmt(fit["rmse_dop"]), f"{fit['chi2_red']:.3f}", f"{fit['elpd_loo']:.2f}", f"{fit['elpd_loo_se']:.2f}"]])
+         + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
+                        + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
+         + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction.")
+         + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")),
+        ("Posterior", H.image(H.figure_to_data_uri(figures["corner.png"]), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),
+    ]
+    if notes:
+        sections.insert(4, ("Notes", H.bullets(notes)))
+    return H.page(f"spacepol inversion: {s['model']}", sections)
+
+
+def _fmt(x):
+    return "n/a" if x is None else f"{x:.4g}"

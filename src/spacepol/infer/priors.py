@@ -43,7 +43,7 @@ def _check_interval(lower: float, upper: float, what: str) -> None:
     if not (np.isfinite(lower) and np.isfinite(upper)):
         raise ParameterError(f"{what}: bounds must be finite, got [{lower}, {upper}]")
     if not lower < upper:
-        raise ParameterError(f"{what}: lower bound {lower} is not below upper bound {upper}")
+        raise ParameterError(f"{what}: lower bound {lower:g} is not below upper bound {upper:g}")
 
 
 @dataclass(frozen=True)

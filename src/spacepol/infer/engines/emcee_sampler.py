@@ -1,7 +1,8 @@
 """emcee with a vectorised log-probability, ridge-friendly moves, automatic length and resuming.
 
 * Walkers start in a small ball around a quick differential-evolution optimum of the log
-  posterior (inside the prior support), not scattered over the prior.
+  posterior (inside the prior support), not scattered over the prior (``initial="prior"``
+  does that, or pass an array).
 * Moves: differential evolution (0.8) and DE snooker (0.2): DE moves follow the long ridges
   that DOP-only data leave (k_s against rho_d).  On an 84-point DOP set with the paper model
   this mixture gave tau ~ 70 steps against ~ 200 for the stretch move alone.
@@ -104,6 +105,8 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         if initial is None:
             initial, quick = initial_ball(posterior, rng, walkers)
             init_info = {"init_evaluations": quick.n_evaluations}
+        elif isinstance(initial, str) and initial == "prior":
+            initial = posterior.priors.sample(rng, walkers)
         state = initial
 
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True

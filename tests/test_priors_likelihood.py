@@ -1,0 +1,96 @@
+"""Priors as objects, prior files, and the likelihood's densities."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from spacepol.errors import ParameterError
+from spacepol.infer.likelihood import Likelihood
+from spacepol.infer.posterior import Posterior
+from spacepol.infer.prior_set import PriorSet, read_prior_file
+from spacepol.infer.priors import Fixed, LogUniform, TruncatedNormal, Uniform
+from spacepol.io.measurements import Dataset
+from spacepol.physics import Model
+
+
+@pytest.mark.parametrize("prior", [Uniform(1.0, 3.0), LogUniform(0.01, 10.0), TruncatedNormal(1.4, 0.2, 1.0, 2.0)])
+def test_rescale_is_the_inverse_cdf_and_ln_prob_integrates_to_one(prior, rng):
+    u = rng.uniform(size=200000)
+    x = prior.rescale(u)
+    assert np.all((x >= prior.lower) & (x <= prior.upper))
+    grid = np.linspace(prior.lower, prior.upper, 200001)
+    density = np.exp(prior.ln_prob(grid))
+    assert np.trapezoid(density, grid) == pytest.approx(1.0, abs=1e-6)
+    # the histogram of rescaled uniforms matches the density (KS test, fixed seed)
+    cdf = lambda v: np.interp(v, grid, np.concatenate([[0], np.cumsum((density[1:] + density[:-1]) / 2 * np.diff(grid))]))
+    assert stats.kstest(x[:5000], cdf).pvalue > 0.01
+    assert np.all(np.isinf(prior.ln_prob(np.array([prior.lower - 1e-6, prior.upper + 1e-6]))))
+
+
+def test_prior_file_overrides_fixes_and_frees(tmp_path):
+    f = tmp_path / "p.toml"
+    f.write_text('[n]\ndistribution = "normal"\nmu = 1.4\nsigma = 0.1\nlower = 1.0\nupper = 2.0\n'
+                 '[k]\nfixed = 0.0\n[sigma_p]\ndistribution = "loguniform"\nlower = 0.001\nupper = 0.1\n')
+    priors = PriorSet(Model.from_string("paper").parameters, read_prior_file(f))
+    assert priors.names == ["n", "sigma", "ks", "sigma_p", "rho_d"]  # model (effect) order
+    assert priors.fixed == {"k": 0.0, "sigma_r": 0.0136, "u_p": 9.0, "v_p": 1.0}
+    assert isinstance(priors.priors["n"], TruncatedNormal) and isinstance(priors.priors["k"], Fixed)
+
+
+@pytest.mark.parametrize("text,message", [
+    ('[n]\nlower = 2.0\nupper = 1.0\n', "lower bound 2 is not below upper bound 1"),
+    ('[n]\ndistribution = "loguniform"\nlower = 0.0\nupper = 1.0\n', "lower bound must be > 0"),
+    ('[k]\nlower = -1.0\nupper = 1.0\n', "reaches outside its physical range"),
+    ('[n]\nlowr = 1.0\nupper = 2.0\n', "unknown key(s) lowr"),
+    ('[roughness]\nfixed = 0.1\n', "no parameter(s) roughness"),
+    ('[n]\ndistribution = "cauchy"\nlower = 1.0\nupper = 2.0\n', "unknown distribution 'cauchy'"),
+    ('[n]\nlower = "one"\nupper = 2.0\n', "lower must be a number"),
+    ('[n\n', "not valid TOML"),
+])
+def test_impossible_priors_are_clear_errors(tmp_path, text, message):
+    from spacepol.errors import SpacepolError
+
+    f = tmp_path / "p.toml"
+    f.write_text(text)
+    with pytest.raises(SpacepolError) as err:
+        PriorSet(Model.from_string("paper").parameters, read_prior_file(f), where=str(f))
+    assert message in str(err.value) and str(f) in str(err.value)
+
+
+def _dataset(n=12, dop_err=True):
+    rng = np.random.default_rng(0)
+    ti, tr = np.full(n, 40.0), np.linspace(5, 75, n)
+    model = Model.from_string("paper")
+    data = Dataset(ti, tr, np.full(n, 180.0))
+    truth = model.evaluate({"n": 1.5, "k": 0.1}, data.geometry)
+    data.dop = truth.dop + 0.01 * rng.standard_normal(n)
+    data.dop_err = np.full(n, 0.01) if dop_err else None
+    data.brdf = truth.brdf * np.exp(0.05 * rng.standard_normal(n))
+    return data, model
+
+
+def test_gaussian_and_student_t_densities_match_scipy():
+    data, model = _dataset()
+    params = {"n": np.array([1.5, 1.6]), "k": np.array([0.1, 0.2])}
+    mu = model.evaluate(params, data.geometry)
+    gauss = Likelihood(data, model, observables=["dop"]).pointwise(params)
+    np.testing.assert_allclose(gauss, stats.norm.logpdf(data.dop, mu.dop, 0.01), rtol=1e-12)
+    robust = Likelihood(data, model, observables=["dop"], robust=True, nu=4.0).pointwise(params)
+    np.testing.assert_allclose(robust, stats.t.logpdf(data.dop, 4.0, mu.dop, 0.01), rtol=1e-12)
+
+
+def test_missing_errors_become_nuisance_parameters():
+    data, model = _dataset(dop_err=False)
+    lik = Likelihood(data, model)
+    assert [p.name for p in lik.nuisance] == ["sigma_dop", "sigma_brdf_rel"]
+    params = {"n": np.array([1.5]), "k": np.array([0.1]), "sigma_dop": np.array([0.02]), "sigma_brdf_rel": np.array([0.1])}
+    ll = lik.pointwise(params)
+    mu = model.evaluate({"n": 1.5, "k": 0.1}, data.geometry)
+    np.testing.assert_allclose(ll[0, :12], stats.norm.logpdf(data.dop, mu.dop, 0.02), rtol=1e-12)
+    np.testing.assert_allclose(ll[0, 12:], stats.norm.logpdf(np.log(data.brdf), np.log(mu.brdf), 0.1), rtol=1e-12)
+
+
+def test_fewer_points_than_parameters_is_an_error():
+    data, model = _dataset(n=3, dop_err=False)
+    with pytest.raises(ParameterError, match="3 observations are fewer than the 6 free parameters"):
+        Posterior.build(data, model, observables=["dop"])

@@ -68,11 +68,10 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         backend_path = Path(backend_path)
         print_ = fingerprint(posterior, walkers, seed)
         _check_backend(backend_path, print_)
+        _stamp_backend(backend_path, print_)  # before sampling, so an interrupted chain is recognised
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
                           check_every=check_every)
-    if backend_path is not None:
-        _stamp_backend(backend_path, print_)
     idata = to_inference_data(result, posterior, rng)
     loo_result = loo(idata)
     summary = {

@@ -10,8 +10,9 @@ from .prior_set import PriorSet
 
 
 class Posterior:
-    def __init__(self, likelihood: Likelihood, priors: PriorSet):
+    def __init__(self, likelihood: Likelihood, priors: PriorSet, prior_only: bool = False):
         self.likelihood, self.priors = likelihood, priors
+        self.prior_only = prior_only  # sample the prior alone (a check of the sampler and the priors)
         self.names = priors.names
         self.n_evaluations = 0
         if likelihood.n_obs < priors.ndim:
@@ -39,6 +40,8 @@ class Posterior:
         theta = np.atleast_2d(theta)
         lp = self.priors.ln_prob(theta)
         inside = np.isfinite(lp)
+        if self.prior_only:
+            return lp
         if np.any(inside):
             ll = self.log_prob_pointwise(theta[inside]).sum(axis=-1)
             self.n_evaluations += int(inside.sum())

@@ -32,6 +32,13 @@ from ..objective import NegativeLogPosterior
 from ..result import Result
 
 
+def _has_chain(path) -> bool:
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        return "mcmc" in f
+
+
 def default_walkers(ndim: int) -> int:
     return max(64, 2 * ((8 * ndim + 1) // 2))
 
@@ -85,7 +92,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     resumed = False
     if backend_path is not None:
         backend = emcee.backends.HDFBackend(str(backend_path), name="mcmc")
-        if Path(backend_path).exists() and backend.initialized and backend.iteration > 0:
+        if Path(backend_path).exists() and _has_chain(backend_path) and backend.iteration > 0:
             if backend.shape != (walkers, ndim):
                 from ...errors import SpacepolError
 

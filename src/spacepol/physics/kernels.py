@@ -16,8 +16,7 @@ import numpy as np
 _TWO_PI = 2.0 * math.pi
 
 
-@numba.njit(parallel=True, cache=True, fastmath=False)
-def specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac, cos2eta, sin2eta, factor, ggx, out):
+def _specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac, cos2eta, sin2eta, factor, ggx, out):
     """Write the specular lobe's Stokes vector (unpolarized incidence) into ``out`` (4, P, N).
 
     n, k, sigma, ks: (P,) parameter sets; the other inputs are (N,) geometry terms except
@@ -59,8 +58,7 @@ def specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac,
             out[3, p, j] = 0.0
 
 
-@numba.njit(parallel=True, cache=True)
-def stokes_dop(stokes, out):
+def _stokes_dop(stokes, out):
     """DOP = |S_pol| / S0 (0 where S0 = 0), clipped at 1 against rounding; stokes (4, P, N)."""
     n_sets, n_geo = stokes.shape[1], stokes.shape[2]
     for p in numba.prange(n_sets):
@@ -71,6 +69,26 @@ def stokes_dop(stokes, out):
                 out[p, j] = min(pol / s0, 1.0)
             else:
                 out[p, j] = 0.0
+
+
+# Each kernel compiled twice: threads pay off on large batches (a benchmark's 4096 parameter
+# sets), but their start-up costs more than the work on an MCMC step's few walkers.
+PARALLEL_THRESHOLD = 16384  # elements (parameter sets x geometries)
+_specular_parallel = numba.njit(parallel=True, cache=True)(_specular_stokes)
+_specular_serial = numba.njit(cache=True)(_specular_stokes)
+_dop_parallel = numba.njit(parallel=True, cache=True)(_stokes_dop)
+_dop_serial = numba.njit(cache=True)(_stokes_dop)
+
+
+def specular_stokes(n, k, sigma, ks, *rest):
+    out = rest[-1]
+    kernel = _specular_parallel if out.shape[1] * out.shape[2] >= PARALLEL_THRESHOLD else _specular_serial
+    kernel(n, k, sigma, ks, *rest)
+
+
+def stokes_dop(stokes, out):
+    kernel = _dop_parallel if out.size >= PARALLEL_THRESHOLD else _dop_serial
+    kernel(stokes, out)
 
 
 def as_sets(value, n_sets):

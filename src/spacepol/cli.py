@@ -54,6 +54,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=20000, help="cap on the chain length (steps)")
     p.add_argument("--robust", action="store_true", help="Student-t likelihood (nu = 4) instead of Gaussian")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--reference", action="append", default=[], metavar="NAME=VALUE",
+                   help="a known value to compare the posterior with (e.g. n=1.35 for PTFE)")
     p.add_argument("--out", default="reports/run")
 
     p = sub.add_parser("optimize", help="one optimizer's best fit as JSON on stdout")

@@ -150,6 +150,21 @@ def build_posterior(args, data, robust=False):
                            where=args.prior or "priors")
 
 
+def parse_references(items, posterior) -> dict[str, float]:
+    refs = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep:
+            raise ParameterError(f"--reference '{item}': expected NAME=VALUE")
+        if name not in posterior.names:
+            raise ParameterError(f"--reference '{item}': '{name}' is not a free parameter ({', '.join(posterior.names)})")
+        try:
+            refs[name] = float(text)
+        except ValueError:
+            raise ParameterError(f"--reference '{item}': '{text}' is not a number") from None
+    return refs
+
+
 def run(args) -> int:
     from .infer.inversion import invert
     from .report.run_report import write_run_report
@@ -158,6 +173,7 @@ def run(args) -> int:
         raise ParameterError(f"--steps {args.steps}: need at least 100")
     data = load_dataset(args)
     posterior = build_posterior(args, data, robust=args.robust)
+    references = parse_references(args.reference, posterior)
     out = Path(args.out)
     if not args.quiet:
         print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
@@ -165,7 +181,7 @@ def run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,
                  backend_path=out / "chain.h5", progress=not args.quiet)
-    summary = write_run_report(inv, out, args.data)
+    summary = write_run_report(inv, out, args.data, references=references)
     d = summary["diagnostics"]
     print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, report.html "
           f"(R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")

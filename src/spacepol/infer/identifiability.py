@@ -17,6 +17,33 @@ def _prior_width(prior, rng):
     return float(draws[1] - draws[0])
 
 
+def _spread(x):
+    return float(np.subtract(*np.percentile(x, [95, 5])))
+
+
+def _intensity_ratio_findings(flat, names, lobe):
+    """DOP is a ratio of intensities: k_s and the diffuse albedo enter only through their ratio
+    (and, in the exact specular geometry, through k_s / (sigma^2 rho_d))."""
+    log = {n: np.log(np.maximum(flat[:, names.index(n)], 1e-300)) for n in ("ks", lobe) + (("sigma",) if "sigma" in names else ())}
+    alone = min(_spread(log["ks"]), _spread(log[lobe]))
+    ratio = _spread(log["ks"] - log[lobe])
+    out = []
+    if ratio < 0.5 * alone:
+        out.append(f"From DOP alone only the ratio k_s/{lobe} is measured (90 % range of its log {ratio:.2f}, against "
+                   f"{alone:.2f} for either alone): DOP is a ratio of intensities, so scaling both lobes together changes "
+                   f"nothing. Add BRDF (intensity) data to separate them.")
+    elif "sigma" in log:
+        folded = _spread(log["ks"] - log[lobe] - 2 * log["sigma"])
+        if folded < 0.5 * min(alone, ratio, _spread(log["sigma"])):
+            out.append(f"From DOP alone only k_s/(sigma^2 {lobe}) is measured (90 % range of its log {folded:.2f}, against "
+                       f"{alone:.2f} for k_s or {lobe} alone): at the specular peak the facet distribution is 1/(2 pi sigma^2), "
+                       f"so roughness folds into the intensity ratio. Off-specular geometries fix sigma; BRDF data fix k_s and {lobe}.")
+    if not out:
+        out.append(f"k_s and {lobe} enter DOP only as a ratio of intensities; with these data neither they nor their ratio "
+                   f"is pinned down well. BRDF (intensity) data would separate them.")
+    return out
+
+
 def identifiability(posterior: Posterior, result: Result) -> dict:
     flat = result.flat_samples()
     names = result.names
@@ -39,16 +66,7 @@ def identifiability(posterior: Posterior, result: Result) -> dict:
     observables = posterior.likelihood.observables
     lobes = [n for n in ("rho_d", "rho_pd") if n in names]
     if "ks" in names and lobes and "brdf" not in observables:
-        lobe = lobes[0]
-        j_ks, j_l = names.index("ks"), names.index(lobe)
-        ratio = np.log(np.maximum(flat[:, j_ks], 1e-300) / np.maximum(flat[:, j_l], 1e-300))
-        spread_ratio = float(np.subtract(*np.percentile(ratio, [95, 5])))
-        spread_each = float(np.subtract(*np.percentile(np.log(np.maximum(flat[:, j_ks], 1e-300)), [95, 5])))
-        findings.append(
-            f"From DOP alone only the ratio k_s/{lobe} is measured (its log has a 90 % range of "
-            f"{spread_ratio:.2f}, against {spread_each:.2f} for log k_s alone): DOP is a ratio of intensities, "
-            f"so scaling both lobes together changes nothing. Add BRDF (intensity) data to separate them."
-        )
+        findings.extend(_intensity_ratio_findings(flat, names, lobes[0]))
     for a, b, r in pairs:
         findings.append(f"{a} and {b} are strongly correlated (r = {r:+.2f}): the data fix a combination of them better than either.")
     if not findings:

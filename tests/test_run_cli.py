@@ -50,13 +50,13 @@ def test_run_writes_the_design_outputs(run_out):
 
 
 def test_run_explains_the_dop_only_degeneracy(tmp_path):
-    """DOP-only data and the paper model: the report says only k_s/rho_d is measured.
+    """DOP-only data (black paint, off-specular) and the paper model: the report says only k_s/rho_d is measured.
     (A short capped chain: the finding does not need a converged one, and the report says it is not.)"""
     data = tmp_path / "al.csv"
-    assert cli("synth", "--model", "paper", "--set", "n=1.24", "--set", "k=6.6", "--noise-dop", "0.005",
-               "--seed", "3", "--out", data).returncode == 0
+    assert cli("synth", "--model", "paper", "--set", "n=1.405", "--set", "k=0.2289", "--set", "sigma=0.25",
+               "--set", "ks=0.5", "--set", "rho_d=0.2", "--noise-dop", "0.005", "--seed", "3", "--out", data).returncode == 0
     out = tmp_path / "out"
-    run = cli("run", data, "--model", "paper", "--steps", "1500", "--quiet", "--out", out)
+    run = cli("run", data, "--model", "paper", "--steps", "2500", "--quiet", "--out", out)
     assert run.returncode == 0, run.stderr
     s = json.loads((out / "summary.json").read_text())
     findings = " ".join(s["identifiability"]["findings"])

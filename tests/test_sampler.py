@@ -106,7 +106,7 @@ def test_recovery_90_percent_intervals_cover_the_truth():
         for seed in (11, 12):
             data = synthetic(spec, truth, seed=seed)
             post = Posterior.build(data, Model.from_string(spec))
-            res = sample_emcee(post, np.random.default_rng(5), progress=False, max_steps=8000)
+            res = sample_emcee(post, np.random.default_rng(5), progress=False)
             assert not res.info["capped"]
             cover = _covers(res, truth)
             print(spec, seed, cover)

@@ -61,3 +61,12 @@ class History:
 
     def as_array(self):
         return np.array(self.points, dtype=float)
+
+    def to_result(self, method, objective, model_name, seconds, seed, info) -> Result:
+        """The Result of an optimizer that recorded its evaluations here."""
+        return Result(
+            method=method, model=model_name, names=list(objective.names),
+            best=dict(zip(objective.names, map(float, self.best_x))), objective=self.best,
+            objective_name=objective.name, n_evaluations=self.evaluations, seconds=seconds,
+            seed=-1 if seed is None else seed, history=self.as_array(), info=info,
+        )

@@ -7,7 +7,7 @@ import time
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from ..result import History, Result
+from ..result import History
 
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,
@@ -38,11 +38,5 @@ def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evalua
         local = minimize(scalar, best_u, method="L-BFGS-B", bounds=[(0.0, 1.0)] * ndim)
         best_u = np.clip(local.x, 0, 1)
         f(best_u[:, None])
-    best_x = history.best_x
-    return Result(
-        method="de", model=model_name, names=list(objective.names),
-        best=dict(zip(objective.names, map(float, best_x))), objective=history.best,
-        objective_name=objective.name, n_evaluations=history.evaluations,
-        seconds=time.perf_counter() - start, seed=-1 if seed is None else seed, history=history.as_array(),
-        info={"message": str(res.message), "iterations": int(res.nit)},
-    )
+    return history.to_result("de", objective, model_name, time.perf_counter() - start, seed,
+                             {"message": str(res.message), "iterations": int(res.nit)})

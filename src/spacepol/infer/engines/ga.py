@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..result import History, Result
+from ..result import History
 
 
 def _decode(chromosomes, bits):
@@ -57,14 +57,8 @@ def run_ga(objective, rng: np.random.Generator, model_name: str = "", bits: int 
         pop[0] = elite
         fitness = evaluate(pop)
 
-    best_x = history.best_x
-    return Result(
-        method="ga", model=model_name, names=list(objective.names),
-        best=dict(zip(objective.names, map(float, best_x))), objective=history.best,
-        objective_name=objective.name, n_evaluations=history.evaluations,
-        seconds=time.perf_counter() - start, seed=-1 if seed is None else seed, history=history.as_array(),
-        info={"generations": generations, "stop_reason": stop_reason, "bits": bits},
-    )
+    return history.to_result("ga", objective, model_name, time.perf_counter() - start, seed,
+                             {"generations": generations, "stop_reason": stop_reason, "bits": bits})
 
 
 def _crossover(pop, rng, probability):

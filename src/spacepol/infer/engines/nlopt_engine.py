@@ -8,7 +8,7 @@ import nlopt
 import numpy as np
 
 from ...errors import UnknownNameError
-from ..result import History, Result
+from ..result import History
 
 NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
 
@@ -46,10 +46,5 @@ def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: s
         status = opt.last_optimize_result()
     except (nlopt.RoundoffLimited, RuntimeError) as exc:  # keep the best point found so far
         status = f"stopped: {type(exc).__name__}"
-    return Result(
-        method=f"nlopt:{algorithm}", model=model_name, names=list(objective.names),
-        best=dict(zip(objective.names, map(float, history.best_x))), objective=history.best,
-        objective_name=objective.name, n_evaluations=history.evaluations,
-        seconds=time.perf_counter() - start, seed=-1 if seed is None else seed, history=history.as_array(),
-        info={"status": str(status)},
-    )
+    return history.to_result(f"nlopt:{algorithm}", objective, model_name, time.perf_counter() - start, seed,
+                             {"status": str(status)})

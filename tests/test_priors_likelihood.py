@@ -94,3 +94,25 @@ def test_fewer_points_than_parameters_is_an_error():
     data, model = _dataset(n=3, dop_err=False)
     with pytest.raises(ParameterError, match="3 observations are fewer than the 6 free parameters"):
         Posterior.build(data, model, observables=["dop"])
+
+
+def test_normalised_stokes_observables():
+    """q = S1/S0, u = S2/S0 with a shared inferred noise; the model's sign convention is the data's."""
+    from spacepol.paths import bundled
+    from spacepol.io import read_measurements
+
+    ptfe = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633).in_plane()
+    model = Model.from_string("paper")
+    lik = Likelihood(ptfe, model, observables=["q", "u"])
+    assert [p.name for p in lik.nuisance] == ["sigma_qu"]
+    params = {"n": np.array([1.35]), "k": np.array([0.0]), "sigma": np.array([0.3]), "ks": np.array([0.1]),
+              "rho_d": np.array([0.9]), "sigma_qu": np.array([0.01])}
+    pred = model.evaluate({k: v[0] for k, v in params.items() if k != "sigma_qu"}, ptfe.geometry)
+    ll = lik.pointwise(params)[0]
+    np.testing.assert_allclose(ll[: len(ptfe)], stats.norm.logpdf(ptfe.q, pred.stokes[1] / pred.stokes[0], 0.01), rtol=1e-12)
+    # In the plane of incidence u = 0 for the model, and the specular lobe's q > 0 (s-polarized) where
+    # PTFE's measured q is positive too (large angles on the specular side).
+    side = (ptfe.dphi == 180.0) & (ptfe.theta_i >= 45) & (ptfe.theta_r >= 40)
+    assert np.all(pred.stokes[1][side] > 0) and np.all(ptfe.q[side] > 0)
+    assert np.allclose(pred.stokes[2], 0.0, atol=1e-15)
+    assert Likelihood(ptfe, model).observables == ["dop", "brdf"]  # q, u are opt-in

@@ -45,7 +45,7 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
         p.add_argument("--wavelength-um", type=float, help="select one wavelength of a multi-wavelength file")
         p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
-        p.add_argument("--observables", help="comma-separated subset of dop,brdf (default: all in the file)")
+        p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
         p.add_argument("--seed", type=int, default=0)
 
     p = sub.add_parser("run", help="emcee posterior with corner, fit and residual plots and a report")

@@ -38,7 +38,7 @@ def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
         if err is not None:
             out[o] = np.broadcast_to(err, (len(flat_theta), len(err)))
         else:
-            key = "sigma_dop" if o == "dop" else "sigma_brdf_rel"
+            key = lik.noise_parameter(o)
             out[o] = np.broadcast_to(np.asarray(params[key])[:, None], (len(flat_theta), len(lik.data)))
     return out
 

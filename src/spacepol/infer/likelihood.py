@@ -4,6 +4,10 @@
   noise level ``sigma_dop`` is a nuisance parameter inferred with the rest.
 * BRDF: with ``brdf_err``, Gaussian in BRDF; without it, Gaussian in log BRDF with an inferred
   relative noise ``sigma_brdf_rel`` (BRDF errors are multiplicative: gain, spot size, solid angle).
+* Stokes: the normalised q = S1/S0 and u = S2/S0 (``--observables q,u``; from s0,s1,s2 columns or
+  a Mueller file's first column), Gaussian with one inferred noise ``sigma_qu``. They carry the
+  sign and orientation of the polarization that DOP discards (DOP = sqrt(q^2 + u^2) for S3 = 0),
+  so use them instead of DOP, not with it.
 
 The pointwise log-likelihood (one entry per observation) is kept for PSIS-LOO.
 """
@@ -21,7 +25,8 @@ from ..physics.model import Model
 from ..physics.parameter import Parameter
 from .priors import LogUniform
 
-OBSERVABLES = ("dop", "brdf")
+OBSERVABLES = ("dop", "brdf", "q", "u")
+DEFAULT_OBSERVABLES = ("dop", "brdf")
 _LOG_2PI = math.log(2 * math.pi)
 _BRDF_FLOOR = 1e-300
 
@@ -30,7 +35,7 @@ class Likelihood:
     def __init__(self, data: Dataset, model: Model, observables=None, robust: bool = False, nu: float = 4.0):
         self.data, self.model = data, model
         available = [o for o in OBSERVABLES if getattr(data, o) is not None]
-        self.observables = list(observables) if observables else available
+        self.observables = list(observables) if observables else [o for o in available if o in DEFAULT_OBSERVABLES]
         for name in self.observables:
             if name not in OBSERVABLES:
                 raise ParameterError(f"unknown observable '{name}' (use {', '.join(OBSERVABLES)})")
@@ -44,7 +49,8 @@ class Likelihood:
         for name in self.observables:
             err = getattr(data, f"{name}_err")
             if err is None:
-                self.nuisance.append(_NUISANCE[name])
+                if _NUISANCE[name] not in self.nuisance:
+                    self.nuisance.append(_NUISANCE[name])
             else:
                 if np.any(err <= 0):
                     raise ParameterError(f"{data.source}: {name}_err must be > 0 to weigh the fit (found {err.min():g})")
@@ -61,7 +67,20 @@ class Likelihood:
 
     def predict(self, model_params: dict) -> dict[str, np.ndarray]:
         pred = self.model.evaluate(model_params, self.geometry, check=False)
-        return {name: (pred.dop if name == "dop" else pred.brdf) for name in self.observables}
+        out = {}
+        for name in self.observables:
+            if name == "dop":
+                out[name] = pred.dop
+            elif name == "brdf":
+                out[name] = pred.brdf
+            else:
+                s0 = np.where(pred.stokes[0] > 0, pred.stokes[0], np.inf)
+                out[name] = pred.stokes[1 if name == "q" else 2] / s0
+        return out
+
+    def noise_parameter(self, name: str) -> str | None:
+        """The nuisance parameter holding ``name``'s noise, or None when the file gives errors."""
+        return None if name in self._errors else _NUISANCE[name].name
 
     def pointwise(self, params: dict) -> np.ndarray:
         """Log-likelihood per observation, shape (P, n_obs), for P parameter sets."""
@@ -70,8 +89,8 @@ class Likelihood:
         blocks = []
         for name in self.observables:
             y, mu = getattr(self.data, name), pred[name]
-            if name == "dop":
-                scale = self._errors["dop"] if "dop" in self._errors else np.asarray(params["sigma_dop"])[:, None]
+            if name != "brdf":
+                scale = self._errors[name] if name in self._errors else np.asarray(params[_NUISANCE[name].name])[:, None]
                 resid = y - mu
             elif "brdf" in self._errors:
                 scale, resid = self._errors["brdf"], y - mu
@@ -90,7 +109,11 @@ class Likelihood:
         return const - np.log(scale) - 0.5 * (nu + 1) * np.log1p(z2 / nu)
 
 
+_SIGMA_QU = Parameter("sigma_qu", "", LogUniform(1e-4, 0.5), 0.01,
+                      "noise of the normalised Stokes parameters q, u (inferred)", physical=(1e-12, np.inf))
 _NUISANCE = {
+    "q": _SIGMA_QU,
+    "u": _SIGMA_QU,
     "dop": Parameter("sigma_dop", "", LogUniform(1e-4, 0.5), 0.01,
                      "DOP noise level (inferred: the file has no dop_err)", physical=(1e-12, np.inf)),
     "brdf": Parameter("sigma_brdf_rel", "", LogUniform(1e-3, 2.0), 0.05,

@@ -49,6 +49,18 @@ class Dataset:
     def __len__(self):
         return len(self.theta_i)
 
+    # Normalised Stokes parameters q = S1/S0, u = S2/S0 (s-polarized light has q > 0).
+    @property
+    def q(self):
+        return None if self.stokes is None else self.stokes[1] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
+
+    @property
+    def u(self):
+        return None if self.stokes is None else self.stokes[2] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
+
+    q_err = None
+    u_err = None
+
     @property
     def geometry(self) -> Geometry:
         if not hasattr(self, "_geometry"):

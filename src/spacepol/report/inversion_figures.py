@@ -55,7 +55,7 @@ def fit_figure(posterior, result, observable: str = "dop", max_draws: int = 2000
         ax.errorbar(x, y[idx], yerr=None if err is None else err[idx], fmt="o", ms=3, color="k", lw=0.8, label="data")
         ax.set_title(f"theta_i = {ti:g} deg", fontsize=9)
         ax.set_xlabel("theta_r (deg, < 0: dphi != 180)", fontsize=8)
-        ax.set_ylabel(observable.upper() if observable == "dop" else "BRDF (sr^-1)", fontsize=8)
+        ax.set_ylabel({"dop": "DOP", "brdf": "BRDF (sr^-1)", "q": "q = S1/S0", "u": "u = S2/S0"}[observable], fontsize=8)
         ax.grid(alpha=0.3)
     for ax in axes[len(panels):]:
         ax.set_visible(False)

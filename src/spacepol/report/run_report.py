@@ -52,7 +52,7 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
     truths = truths_from_metadata(posterior.likelihood.data.metadata)
     figures = {
         "corner.png": corner_figure(result, truths),
-        "fit.png": fit_figure(posterior, result, "dop" if "dop" in posterior.likelihood.observables else "brdf"),
+        "fit.png": fit_figure(posterior, result, posterior.likelihood.observables[0]),
         "residuals.png": residual_figure(posterior, result),
     }
     for name, fig in figures.items():

@@ -38,7 +38,8 @@ def compare_with_references(result, references: dict) -> dict:
             text = (f"{name}: the posterior (median {med:.4g}, 90 % [{lo:.4g}, {hi:.4g}]) excludes the reference "
                     f"{value:g} (which sits at the {pct:.1f}th percentile). The data are precise enough to tell, "
                     f"so it is the model that is wrong: a physical effect present in the data is missing and "
-                    f"{name} moves to absorb it. Look at the residual structure and try `invert-mcmc diagnose`.")
+                    f"{name} moves to absorb it. Look at the residual structure (residuals.png) and compare models with "
+                    f"an added effect (e.g. --model paper+polarized_diffuse).")
         out[name] = {"value": value, "percentile": pct, "consistent": consistent, "explanation": text}
     return out
 

@@ -6,6 +6,13 @@ matplotlib.use("Agg")
 
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# CI explores the same examples every run (a failure is reproducible, never flaky); local runs
+# draw new ones each time and so keep searching.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 # Tests never read ../shared: bundled data come from the project's own data/ folder.
 os.environ.setdefault("SPACEPOL_DATA", os.path.join(os.path.dirname(__file__), "..", "data"))

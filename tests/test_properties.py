@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from spacepol.physics import Geometry, Model
 from spacepol.physics.effects import registry
@@ -76,6 +76,20 @@ def test_compiled_kernel_equals_numpy_path(spec, monkeypatch):
     slow = model.evaluate(params, geometry)
     np.testing.assert_allclose(fast.stokes, slow.stokes, rtol=1e-12, atol=1e-300)
     np.testing.assert_allclose(fast.dop, slow.dop, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("k", [1e-8, 1e-4, 0.0])
+def test_power_and_amplitude_forms_agree_for_nearly_index_matched_media(k):
+    """Found by hypothesis: N = 1 + 1e-8 i at normal incidence. R ~ 1e-17 there, and the naive
+    B^2 = (sqrt(C) - D)/2 of eq 17 lost it to rounding (45 % off); the stable form keeps it."""
+    from spacepol.physics import fresnel
+
+    theta = np.radians(np.linspace(0, 89, 90))
+    for n in (1.0, 1.0 + 1e-9, 0.999999):
+        r_s, r_p = fresnel.power(n, k, np.cos(theta), np.sin(theta) ** 2, np.sin(theta) * np.tan(theta))
+        a_s, a_p = fresnel.amplitudes(n + 1j * k, np.cos(theta), np.sin(theta) ** 2)
+        np.testing.assert_allclose(r_s, np.abs(a_s) ** 2, rtol=1e-6, atol=1e-20)  # below 1e-20 reflectance is rounding noise
+        np.testing.assert_allclose(r_p, np.abs(a_p) ** 2, rtol=1e-6, atol=1e-20)
 
 
 def test_no_nan_at_special_geometries():

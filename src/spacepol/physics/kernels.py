@@ -32,13 +32,18 @@ def _specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac
         a2 = 2.0 * var
         weight = ks[p] / (_TWO_PI * var) if not ggx else ks[p] * a2 / math.pi
         n2k2 = nn * nn - kk * kk
-        four_n2k2 = 4.0 * nn * nn * kk * kk
+        nk_sq = (nn * kk) * (nn * kk)
+        four_n2k2 = 4.0 * nk_sq
         row = p * factor_stride
         for j in range(n_geo):
             d = n2k2 - sin2_b[j]
             sqrt_c = math.sqrt(four_n2k2 + d * d)
-            a = math.sqrt(max(0.5 * (sqrt_c + d), 0.0))
-            b2 = max(0.5 * (sqrt_c - d), 0.0)
+            big = 0.5 * (sqrt_c + abs(d))  # no cancellation; the other root from A^2 B^2 = n^2 k^2
+            small = nk_sq / big if big > 0.0 else 0.0
+            if d >= 0.0:
+                a, b2 = math.sqrt(big), small
+            else:
+                a, b2 = math.sqrt(small), big
             c = cos_b[j]
             am, ap = a - c, a + c
             r_s = (am * am + b2) / (ap * ap + b2)

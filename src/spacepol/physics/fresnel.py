@@ -45,19 +45,19 @@ def film_amplitudes(N_substrate, n_film, thickness_um, wavelength_um, cos_theta,
 def _a_b2(n, k, sin2_theta):
     """A and B^2 of eqs 16-19, without cancellation.
 
-    A^2 = (sqrt(C) + D)/2 and B^2 = (sqrt(C) - D)/2 with A^2 B^2 = n^2 k^2: the one of the two
-    that is a difference of nearly equal numbers is taken from the product instead (for weak
-    absorption, B^2 ~ n^2 k^2 / D would otherwise be lost to rounding).
+    A^2 = (sqrt(C) + D)/2 and B^2 = (sqrt(C) - D)/2 with A^2 B^2 = n^2 k^2: where one of the two
+    is a difference of nearly equal numbers it is taken from the product instead (for weak
+    absorption, B^2 ~ n^2 k^2 / D would otherwise be lost to rounding).  Same arithmetic as
+    the compiled kernel.
     """
     d = n**2 - k**2 - sin2_theta
-    nk2 = (n * k) ** 2
+    nk2 = (n * k) * (n * k)
     sqrt_c = np.sqrt(4 * nk2 + d**2)
-    big = 0.5 * (sqrt_c + np.abs(d))
+    a2 = 0.5 * (sqrt_c + d)
+    b2 = 0.5 * (sqrt_c - d)
     with np.errstate(divide="ignore", invalid="ignore"):
-        small = np.where(big > 0, nk2 / big, 0.0)
-    a2 = np.where(d >= 0, big, small)
-    b2 = np.where(d >= 0, small, big)
-    return np.sqrt(a2), b2
+        a2, b2 = (np.where(a2 < 1e-3 * b2, nk2 / b2, a2), np.where((b2 < 1e-3 * a2) & ~(a2 < 1e-3 * b2), nk2 / a2, b2))
+    return np.sqrt(np.maximum(a2, 0.0)), b2
 
 
 def power(n, k, cos_theta, sin2_theta, sin_tan_theta):

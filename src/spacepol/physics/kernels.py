@@ -38,12 +38,14 @@ def _specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac
         for j in range(n_geo):
             d = n2k2 - sin2_b[j]
             sqrt_c = math.sqrt(four_n2k2 + d * d)
-            big = 0.5 * (sqrt_c + abs(d))  # no cancellation; the other root from A^2 B^2 = n^2 k^2
-            small = nk_sq / big if big > 0.0 else 0.0
-            if d >= 0.0:
-                a, b2 = math.sqrt(big), small
-            else:
-                a, b2 = math.sqrt(small), big
+            big_a2 = 0.5 * (sqrt_c + d)  # A^2 and B^2 of eqs 16-17
+            b2 = 0.5 * (sqrt_c - d)
+            # where one is a difference of nearly equal numbers, take it from A^2 B^2 = n^2 k^2
+            if big_a2 < 1e-3 * b2:
+                big_a2 = nk_sq / b2
+            elif b2 < 1e-3 * big_a2:
+                b2 = nk_sq / big_a2
+            a = math.sqrt(max(big_a2, 0.0))
             c = cos_b[j]
             am, ap = a - c, a + c
             r_s = (am * am + b2) / (ap * ap + b2)

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import csv
 import io as _io
-import os
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -233,19 +231,13 @@ def _check_value(value, column, path, line):
 
 def write_table(path, columns: dict, metadata: dict | None = None) -> None:
     """Write a CSV with ``# key: value`` metadata, atomically (a temp file renamed into place)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from .atomic import atomic_path
+
     names = list(columns)
     data = np.column_stack([np.asarray(columns[c], dtype=float) for c in names])
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            for key, value in (metadata or {}).items():
-                fh.write(f"# {key}: {value}\n")
-            fh.write(",".join(names) + "\n")
-            for row in data:
-                fh.write(",".join(repr(float(v)) for v in row) + "\n")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
+        for key, value in (metadata or {}).items():
+            fh.write(f"# {key}: {value}\n")
+        fh.write(",".join(names) + "\n")
+        for row in data:
+            fh.write(",".join(repr(float(v)) for v in row) + "\n")

@@ -93,6 +93,8 @@ def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     # The paper's model, whose only polarizing term is the specular lobe, cannot place PTFE's
     # index at 1.35: the posterior excludes it and the report says the model is what is wrong.
     assert not ref["consistent"] and "model that is wrong" in ref["explanation"]
+    # and the residuals say the misfit is smooth: the BRDF's U shape (the body term's cos(theta_r))
+    assert s["residual_structure"]["runs"]["brdf"]["p"] < 0.01
     assert "model that is wrong" in (out / "report.html").read_text()
 
 

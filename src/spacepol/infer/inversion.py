@@ -90,4 +90,8 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     }
     ident = identifiability(posterior, result)
     summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "findings", "width_ratio")}
+    from ..criticism.residuals import analyse
+
+    structure = analyse(posterior, result.flat_samples())
+    summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings()}
     return Inversion(posterior, result, idata, summary, loo_result, ident)

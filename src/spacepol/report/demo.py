@@ -86,7 +86,8 @@ def run_demo(out: Path, seed: int = 0) -> None:
             [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
              f"ESS min {d['ess_min']:.0f}; reduced chi^2 {summary['fit']['chi2_red']:.2f} with inferred noise "
              f"(DOP {summary['parameters']['sigma_dop']['median']:.4f}, BRDF {100 * summary['parameters']['sigma_brdf_rel']['median']:.0f} %)."]
-            + [summary["references"]["n"]["explanation"]] + summary["identifiability"]["findings"])
+            + [summary["references"]["n"]["explanation"]] + summary["residual_structure"]["findings"]
+            + summary["identifiability"]["findings"])
          + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'
          + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),
                    "Residuals: the BRDF's U shape is the paper's cos(theta_r) body term failing a nearly Lambertian "

@@ -93,6 +93,7 @@ def _html(inv, data_path, figures, truths, notes) -> str:
                         [[_fmt(fit["rmse_dop"]), f"{fit['chi2_red']:.3f}", f"{fit['elpd_loo']:.2f}", f"{fit['elpd_loo_se']:.2f}"]])
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
                         + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
+         + H.bullets(s["residual_structure"]["findings"])
          + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction.")
          + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")),
         ("Posterior", H.image(H.figure_to_data_uri(figures["corner.png"]), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),

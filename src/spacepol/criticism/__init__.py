@@ -1,0 +1,1 @@
+"""Model criticism: where the model fails (residual structure, PPC, LOO) and what is missing."""

@@ -170,6 +170,15 @@ def test_angle_offset_shifts_the_curve():
     assert np.max(np.abs(shifted.dop - ev("paper", PAPER, in_plane(30.0, tr)).dop)) > 1e-3
 
 
+def test_angle_offset_vectorises_over_parameter_sets():
+    g = in_plane(30.0, np.linspace(0, 70, 15))
+    deltas = np.array([-1.5, 0.0, 2.0])
+    batch = ev("paper+angle_offset", {**PAPER, "delta_deg": deltas}, g)
+    assert batch.dop.shape == (3, 15)
+    for i, d in enumerate(deltas):
+        np.testing.assert_allclose(batch.stokes[:, i], ev("paper+angle_offset", {**PAPER, "delta_deg": d}, g).stokes, rtol=1e-12)
+
+
 def test_extinction_scales_dop_and_keeps_intensity():
     g = in_plane(40.0, np.linspace(0, 80, 9))
     base = ev("paper", PAPER, g)

@@ -68,7 +68,14 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seeds", type=int, default=3, help="runs per method")
     p.add_argument("--out", default="reports/compare")
 
-    for name in ("diagnose", "ladder", "sky", "contrast"):
+    p = sub.add_parser("diagnose", help="rank the registered effects that would explain the misfit")
+    data_options(p)
+    p.add_argument("--json", required=True, metavar="FILE", help="write the ranking here")
+    p.add_argument("--candidates", nargs="+", default=None, help="effects to consider (default: every registered one)")
+    p.add_argument("--top", type=int, default=3, help="candidates confirmed by a full refit")
+    p.add_argument("--out", default="reports/diagnose")
+
+    for name in ("ladder", "sky", "contrast"):
         p = sub.add_parser(name, help="(not yet available)")
         p.add_argument("rest", nargs=argparse.REMAINDER)
     return parser

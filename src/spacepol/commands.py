@@ -222,8 +222,39 @@ def compare(args) -> int:
     return 0
 
 
+def diagnose(args) -> int:
+    from .criticism.diagnose import diagnose as run_diagnose
+    from .io.atomic import save_figure, write_json
+    from .physics.registry import registry
+    from .report.inversion_figures import residual_figure
+
+    model = build_model(args.model)
+    if args.prior:
+        raise ParameterError("diagnose uses each effect's default priors; --prior is not supported yet")
+    for name in args.candidates or []:
+        registry.get(name)
+    if args.top < 1:
+        raise ParameterError(f"--top {args.top}: need at least 1")
+    data = load_dataset(args)
+    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    report = run_diagnose(data, model, np.random.default_rng(args.seed), seed=args.seed, observables=observables,
+                          candidates=args.candidates, top=args.top)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    base = report.pop("_base")
+    save_figure(residual_figure(base.posterior, base.result), out / "residuals_base.png")
+    for c in report.pop("_confirmed"):
+        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), out / f"residuals_{c['effect']}.png")
+    write_json(args.json, report)
+    lead = report["ranking"][0] if report["ranking"] else None
+    print(f"verdict: {report['verdict']}" + (f" ({lead['effect']}: delta ELPD {lead['delta_elpd']:+.1f} +- "
+                                             f"{lead['delta_elpd_se']:.1f})" if lead and lead["delta_elpd"] is not None else ""))
+    print(f"wrote {args.json} and residual figures in {out}")
+    return 0
+
+
 def _not_yet(args) -> int:
     raise SpacepolError(f"'{args.command}' is not available yet in this version")
 
 
-diagnose = ladder = sky = contrast = _not_yet
+ladder = sky = contrast = _not_yet

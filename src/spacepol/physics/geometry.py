@@ -74,7 +74,7 @@ class Geometry:
 
     def with_offset(self, delta_deg) -> "Geometry":
         """The same measurements seen through a goniometer whose zero is off by ``delta_deg``."""
-        delta = np.asarray(delta_deg, float)[..., None]
+        delta = np.asarray(delta_deg, float)  # scalar, or (P, 1) for P parameter sets
         return Geometry(self.theta_i + delta, self.theta_r + delta, self.dphi, self.wavelength_um)
 
     def _compute(self):

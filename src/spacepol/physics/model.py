@@ -68,9 +68,10 @@ class Model:
         return cls([registry.get(name) for name in registry.expand(spec)])
 
     def __add__(self, other):
-        if isinstance(other, str):
-            other = Model.from_string(other)
-        others = other.effects if isinstance(other, Model) else [other]
+        if isinstance(other, str):  # names resolve in the combined model ("paper" + "polarized_diffuse")
+            others = [registry.get(name) for name in registry.expand(other)]
+        else:
+            others = other.effects if isinstance(other, Model) else [other]
         return Model(self.effects + list(others))
 
     @property

@@ -42,3 +42,25 @@ def test_diagnose_rejects_unknown_candidates(tmp_path):
                          capture_output=True, text=True)
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
     assert "unknown effect 'sparkle'" in run.stderr and not (tmp_path / "d.json").exists()
+
+
+def test_ladder_shows_the_error_falling(tmp_path):
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from test_residuals import TRUTH, _data
+
+    d = _data("paper+polarized_diffuse", TRUTH, 9)
+    data = tmp_path / "hidden.csv"
+    write_table(data, {"theta_i": d.theta_i, "theta_r": d.theta_r, "dphi": d.dphi, "dop": np.clip(d.dop, 0, 1),
+                       "dop_err": d.dop_err, "brdf": d.brdf, "brdf_err": d.brdf_err})
+    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "ladder", data, "--model", "paper", "--add",
+                          "polarized_diffuse", "--json", tmp_path / "ladder.json", "--out", tmp_path / "lad"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    rungs = json.loads((tmp_path / "ladder.json").read_text())["rungs"]
+    assert [r["model"] for r in rungs] == ["specular+shadowing+body", "specular+shadowing+body+polarized_diffuse"]
+    for r in rungs:
+        assert set(r) >= {"model", "rmse_dop", "chi2_red", "elpd_loo"}
+    assert rungs[1]["rmse_dop"] < 0.2 * rungs[0]["rmse_dop"]
+    assert rungs[0]["chi2_red"] > 10 and abs(rungs[1]["chi2_red"] - 1) < 1.5  # down to the noise floor
+    assert rungs[1]["elpd_loo"] > rungs[0]["elpd_loo"]
+    assert (tmp_path / "lad" / "ladder.png").stat().st_size > 0 and "| 1 |" in (tmp_path / "lad" / "ladder.md").read_text()

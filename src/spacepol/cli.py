@@ -75,7 +75,13 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--top", type=int, default=3, help="candidates confirmed by a full refit")
     p.add_argument("--out", default="reports/diagnose")
 
-    for name in ("ladder", "sky", "contrast"):
+    p = sub.add_parser("ladder", help="fit M, M + E1, M + E1 + E2, ...: the error falling rung by rung")
+    data_options(p)
+    p.add_argument("--add", action="append", required=True, metavar="EFFECT", help="effect added at the next rung")
+    p.add_argument("--json", metavar="FILE", help="write the rungs here (default DIR/ladder.json)")
+    p.add_argument("--out", default="reports/ladder")
+
+    for name in ("sky", "contrast"):
         p = sub.add_parser(name, help="(not yet available)")
         p.add_argument("rest", nargs=argparse.REMAINDER)
     return parser

@@ -253,8 +253,35 @@ def diagnose(args) -> int:
     return 0
 
 
+def ladder(args) -> int:
+    from .criticism.ladder import climb, ladder_figure
+    from .io.atomic import atomic_path, save_figure, write_json
+
+    model = build_model(args.model)
+    current = model
+    for name in args.add:  # check the whole ladder composes before fitting anything
+        current = current + name
+    data = load_dataset(args)
+    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    rungs = climb(data, model, args.add, seed=args.seed, observables=observables)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    save_figure(ladder_figure(rungs), out / "ladder.png")
+    public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rungs]
+    write_json(args.json or out / "ladder.json", {"rungs": public})
+    lines = ["| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO | R-hat max |", "|---|---|---|---|---|---|"]
+    for i, r in enumerate(public):
+        rmse = "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}"
+        lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} | {r['rhat_max']:.3f} |")
+    with atomic_path(out / "ladder.md") as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines))
+    print(f"wrote {args.json or out / 'ladder.json'}, {out / 'ladder.png'}, {out / 'ladder.md'}")
+    return 0
+
+
 def _not_yet(args) -> int:
     raise SpacepolError(f"'{args.command}' is not available yet in this version")
 
 
-ladder = sky = contrast = _not_yet
+sky = contrast = _not_yet

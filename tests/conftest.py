@@ -14,7 +14,7 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
-# Tests never read ../shared: bundled data come from the project's own data/ folder.
+# Bundled data come from the project's own data/ folder only.
 os.environ.setdefault("SPACEPOL_DATA", os.path.join(os.path.dirname(__file__), "..", "data"))
 
 

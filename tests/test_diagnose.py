@@ -9,7 +9,8 @@ import numpy as np
 from spacepol.io.measurements import write_table
 
 
-def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
+def _hidden_polarized_diffuse(tmp_path):
+    """84 points of paper + polarized_diffuse (DOP 0.005, BRDF 3 %) written as a measurement file."""
     sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
     from test_residuals import TRUTH, _data
 
@@ -17,6 +18,11 @@ def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
     data = tmp_path / "hidden.csv"
     write_table(data, {"theta_i": d.theta_i, "theta_r": d.theta_r, "dphi": d.dphi, "dop": np.clip(d.dop, 0, 1),
                        "dop_err": d.dop_err, "brdf": d.brdf, "brdf_err": d.brdf_err})
+    return data
+
+
+def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
+    data = _hidden_polarized_diffuse(tmp_path)
     out = tmp_path / "diag.json"
     run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", data, "--model", "paper", "--json", out,
                           "--candidates", "polarized_diffuse", "extinction", "dop_bias", "--top", "2",
@@ -45,13 +51,7 @@ def test_diagnose_rejects_unknown_candidates(tmp_path):
 
 
 def test_ladder_shows_the_error_falling(tmp_path):
-    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
-    from test_residuals import TRUTH, _data
-
-    d = _data("paper+polarized_diffuse", TRUTH, 9)
-    data = tmp_path / "hidden.csv"
-    write_table(data, {"theta_i": d.theta_i, "theta_r": d.theta_r, "dphi": d.dphi, "dop": np.clip(d.dop, 0, 1),
-                       "dop_err": d.dop_err, "brdf": d.brdf, "brdf_err": d.brdf_err})
+    data = _hidden_polarized_diffuse(tmp_path)
     run = subprocess.run([sys.executable, "-m", "spacepol.cli", "ladder", data, "--model", "paper", "--add",
                           "polarized_diffuse", "--json", tmp_path / "ladder.json", "--out", tmp_path / "lad"],
                          capture_output=True, text=True)

@@ -8,7 +8,7 @@ from matplotlib.figure import Figure
 from ..infer.inversion import invert
 from ..infer.posterior import Posterior
 from ..physics.model import Model
-from .residuals import standardised_residuals
+from ..infer.inference_data import standardised_residuals
 
 
 def climb(data, model: Model, additions: list[str], seed: int = 0, observables=None, max_steps: int = 8000,

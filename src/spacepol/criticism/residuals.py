@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from ..infer.inference_data import noise_scales, predictive_means
+from ..infer.inference_data import median_fit, standardise
 
 VARIABLES = ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level")
 
@@ -42,20 +42,6 @@ class ResidualReport:
                 if t["p"] < alpha:
                     out.append(f"{o}: residuals trend with {var} (Spearman rho = {t['rho']:+.2f}, p = {t['p']:.1g}).")
         return out or ["No structure in the residuals at the 1 % level: consistent with noise."]
-
-
-def standardised_residuals(posterior, samples) -> dict[str, np.ndarray]:
-    lik = posterior.likelihood
-    means = predictive_means(posterior, samples)
-    scales = noise_scales(posterior, samples)
-    out = {}
-    for o in lik.observables:
-        y, mu, s = getattr(lik.data, o), np.median(means[o], axis=0), np.median(scales[o], axis=0)
-        if o == "brdf" and lik.data.brdf_err is None:
-            out[o] = (np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))) / s
-        else:
-            out[o] = (y - mu) / s
-    return out
 
 
 def sweeps(data) -> list[np.ndarray]:
@@ -101,11 +87,11 @@ def lag1(residuals, groups) -> float:
 
 def analyse(posterior, samples) -> ResidualReport:
     data = posterior.likelihood.data
-    res = standardised_residuals(posterior, samples)
+    mu, scale = median_fit(posterior, samples)
+    res = {o: standardise(data, o, mu[o], scale[o]) for o in posterior.likelihood.observables}
     geo = data.geometry
     phase = np.degrees(np.arccos(np.clip(np.sum(geo.k_i * geo.k_r, axis=-1), -1, 1)))
-    dop_level = np.median(predictive_means(posterior, samples).get("dop", np.zeros((1, len(data)))), axis=0) \
-        if "dop" in posterior.likelihood.observables else (data.dop if data.dop is not None else np.zeros(len(data)))
+    dop_level = mu["dop"] if "dop" in mu else (data.dop if data.dop is not None else np.zeros(len(data)))
     variables = {"theta_i": data.theta_i, "theta_r": data.theta_r, "dphi": data.dphi, "phase_deg": phase,
                  "dop_level": dop_level}
     groups = sweeps(data)

@@ -7,7 +7,7 @@ import warnings
 import arviz as az
 import numpy as np
 
-from .inference_data import noise_scales, predictive_means
+from .inference_data import median_fit, standardise
 from .posterior import Posterior
 from .result import Result
 
@@ -42,21 +42,10 @@ def loo(idata) -> dict:
 
 def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:
     """RMSE of DOP and reduced chi^2 at the posterior-median prediction."""
-    flat = result.flat_samples()
-    means = predictive_means(posterior, flat)
-    scales = noise_scales(posterior, flat)
     lik = posterior.likelihood
-    chi2, rmse = 0.0, None
-    for o in lik.observables:
-        y, mu = getattr(lik.data, o), np.median(means[o], axis=0)
-        scale = np.median(scales[o], axis=0)
-        if o == "brdf" and lik.data.brdf_err is None:
-            resid = np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))
-        else:
-            resid = y - mu
-        chi2 += float(np.sum((resid / scale) ** 2))
-        if o == "dop":
-            rmse = float(np.sqrt(np.mean((y - mu) ** 2)))
+    mu, scale = median_fit(posterior, result.flat_samples())
+    chi2 = sum(float(np.sum(standardise(lik.data, o, mu[o], scale[o]) ** 2)) for o in lik.observables)
+    rmse = float(np.sqrt(np.mean((lik.data.dop - mu["dop"]) ** 2))) if "dop" in lik.observables else None
     dof = max(lik.n_obs - posterior.ndim, 1)
     return {"rmse_dop": rmse, "chi2_red": chi2 / dof, "elpd_loo": loo_result["elpd_loo"],
             "elpd_loo_se": loo_result["elpd_loo_se"]}

@@ -43,6 +43,25 @@ def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
     return out
 
 
+def median_fit(posterior: Posterior, samples):
+    """Posterior-median prediction and noise level per observable: ({o: (N,)}, {o: (N,)})."""
+    means, scales = predictive_means(posterior, samples), noise_scales(posterior, samples)
+    return ({o: np.median(m, axis=0) for o, m in means.items()}, {o: np.median(v, axis=0) for o, v in scales.items()})
+
+
+def standardise(data, observable: str, mu, scale):
+    """(data - prediction) / noise, in log space for BRDF with inferred relative noise."""
+    y = getattr(data, observable)
+    if observable == "brdf" and data.brdf_err is None:
+        return (np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))) / scale
+    return (y - mu) / scale
+
+
+def standardised_residuals(posterior: Posterior, samples) -> dict[str, np.ndarray]:
+    mu, scale = median_fit(posterior, samples)
+    return {o: standardise(posterior.likelihood.data, o, mu[o], scale[o]) for o in posterior.likelihood.observables}
+
+
 def replicate(posterior: Posterior, means, scales, rng: np.random.Generator):
     """Replicated data y_rep = prediction + noise drawn like the measurement's."""
     reps = {}

@@ -54,7 +54,7 @@ class Likelihood:
             else:
                 if np.any(err <= 0):
                     raise ParameterError(f"{data.source}: {name}_err must be > 0 to weigh the fit (found {err.min():g})")
-                self._errors[name] = err if name == "dop" else err
+                self._errors[name] = err
         self.geometry = data.geometry
         self.labels = [f"{name}[{i}]" for name in self.observables for i in range(len(data))]
 

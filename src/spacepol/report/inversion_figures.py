@@ -65,21 +65,15 @@ def fit_figure(posterior, result, observable: str = "dop", max_draws: int = 2000
 
 def residual_figure(posterior, result, fig=None) -> Figure:
     """Standardised residuals (data - median prediction) / noise against theta_r, per observable."""
-    from ..infer.inference_data import noise_scales
+    from ..infer.inference_data import standardised_residuals
 
     data = posterior.likelihood.data
-    flat = result.flat_samples()
-    means = predictive_means(posterior, flat)
-    scales = noise_scales(posterior, flat)
+    residuals = standardised_residuals(posterior, result.flat_samples())
     observables = posterior.likelihood.observables
     fig = fig or Figure(figsize=(7.0, 2.8 * len(observables)), layout="constrained")
     axes = fig.subplots(len(observables), 1, squeeze=False).ravel()
     for ax, o in zip(axes, observables):
-        y, mu, s = getattr(data, o), np.median(means[o], axis=0), np.median(scales[o], axis=0)
-        if o == "brdf" and data.brdf_err is None:
-            z = (np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))) / s
-        else:
-            z = (y - mu) / s
+        z = residuals[o]
         for i, (ti, idx) in enumerate(_panels(data)):
             ax.plot(_signed_theta_r(data, idx), z[idx], "o", ms=3, color=f"C{i % 10}", label=f"theta_i = {ti:g}")
         ax.axhline(0, color="k", lw=0.8)

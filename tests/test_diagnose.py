@@ -36,8 +36,10 @@ def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
     assert lead["effect"] == "polarized_diffuse" and lead["significant"]
     assert lead["delta_elpd"] > 2 * lead["delta_elpd_se"]
     assert lead["rmse_dop_after"] < 0.5 * report["fit"]["rmse_dop"]  # the error falls
-    assert (tmp_path / "figs" / "residuals_base.png").exists()
-    assert (tmp_path / "figs" / "residuals_polarized_diffuse.png").exists()
+    for name in ("residuals_base.png", "residuals_polarized_diffuse.png", "signatures.png", "report.html"):
+        assert (tmp_path / "figs" / name).stat().st_size > 0
+    assert report["conclusion"].startswith("Add polarized_diffuse")
+    assert "Improve ELPD-LOO by more than 2 SE: polarized_diffuse" in run.stdout
 
 
 def test_diagnose_rejects_unknown_candidates(tmp_path):
@@ -64,3 +66,70 @@ def test_ladder_shows_the_error_falling(tmp_path):
     assert rungs[0]["chi2_red"] > 10 and abs(rungs[1]["chi2_red"] - 1) < 1.5  # down to the noise floor
     assert rungs[1]["elpd_loo"] > rungs[0]["elpd_loo"]
     assert (tmp_path / "lad" / "ladder.png").stat().st_size > 0 and "| 1 |" in (tmp_path / "lad" / "ladder.md").read_text()
+
+
+def _case_report(case, candidates=None, top=3):
+    from spacepol.criticism.diagnose import diagnose
+    from spacepol.criticism.hidden_effects import BASE, measurement
+    from spacepol.physics import Model
+
+    return diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(case.seed), seed=0,
+                    candidates=candidates, top=top, progress=False)
+
+
+def test_null_set_gets_verdict_none_with_the_whole_library():
+    """Fast version of the null half of the validation suite: no hidden effect, nothing significant."""
+    from spacepol.criticism.hidden_effects import suite
+
+    null = [c for c in suite() if c.effect is None][0]
+    report = _case_report(null)
+    assert report["verdict"] == "none", report["ranking"][:3]
+    assert len(report["ranking"]) >= 8  # every composable built-in effect was screened (oxide_layer too: 0.633 um)
+    assert "nothing is missing" in report["conclusion"]
+
+
+def test_twins_are_reported_with_the_measurement_that_separates_them():
+    """Hidden extinction: depolarization predicts the same DOP and BRDF (the body lobe is depolarized)."""
+    from spacepol.criticism.hidden_effects import Case, score
+
+    case = Case("twin", "extinction", {"e": 0.7}, "paint", 0.002, 0.01, "in-plane-84", 6)
+    report = _case_report(case, candidates=["extinction", "depolarization", "dop_bias"], top=2)
+    lead = report["ranking"][0]
+    assert {report["verdict"], *lead["tied_with"]} == {"extinction", "depolarization"}
+    assert "Mueller matrix" in lead["explanation"]
+    row = score(case, report)
+    assert row["correct"] and abs(row["chi2_red_after"] - 1) < 1.5 and row["covered"] == {"e": True}
+
+
+def test_diagnose_prior_file_applies_to_candidates_and_rejects_unknown_names(tmp_path):
+    from spacepol.paths import bundled
+
+    prior = tmp_path / "p.toml"
+    prior.write_text('[sparkle]\ndistribution = "uniform"\nlower = 0\nupper = 1\n')
+    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
+                          "--wavelength-um", "0.633", "--json", tmp_path / "d.json", "--prior", prior],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1, run.stderr
+    assert "sparkle" in run.stderr and not (tmp_path / "d.json").exists()
+
+
+def test_prior_overrides_reach_the_models_that_have_the_parameter():
+    from spacepol.criticism.diagnose import _build, check_prior_names
+    from spacepol.errors import SpacepolError
+    from spacepol.infer.priors import Fixed, Uniform
+    from spacepol.physics import Model
+    from test_residuals import TRUTH, _data
+
+    data = _data("paper", {k: v for k, v in TRUTH.items() if k != "rho_pd"}, 1)
+    priors = {"rho_pd": Fixed(0.2), "n": Uniform(1.0, 2.0)}
+    check_prior_names(data, Model.from_string("paper"), priors)  # rho_pd belongs to a candidate: accepted
+    base = _build(data, Model.from_string("paper"), None, priors)
+    cand = _build(data, Model.from_string("paper+polarized_diffuse"), None, priors)
+    assert "rho_pd" not in base.priors.priors and base.priors.priors["n"].bounds == (1.0, 2.0)
+    assert cand.priors.fixed["rho_pd"] == 0.2 and cand.priors.priors["n"].bounds == (1.0, 2.0)
+    try:
+        check_prior_names(data, Model.from_string("paper"), {"sparkle": Fixed(1.0)})
+    except SpacepolError as exc:
+        assert "sparkle" in str(exc)
+    else:
+        raise AssertionError("an unknown prior name was accepted")

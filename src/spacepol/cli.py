@@ -84,6 +84,9 @@ def _parser() -> argparse.ArgumentParser:
     for name in ("sky", "contrast"):
         p = sub.add_parser(name, help="(not yet available)")
         p.add_argument("rest", nargs=argparse.REMAINDER)
+    for p in sub.choices.values():  # --effect also after the command name, where users put it
+        p.add_argument("--effect", action="append", default=[], dest="effect_after", metavar="FILE.py:NAME",
+                       help="load a user-defined effect (repeatable); it is then usable by name")
     return parser
 
 
@@ -93,7 +96,7 @@ def main(argv=None) -> int:
     from .errors import SpacepolError
 
     try:
-        for spec in args.effect:
+        for spec in args.effect + getattr(args, "effect_after", []):
             from .physics.registry import registry
 
             registry.load_file(spec)

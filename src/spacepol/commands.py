@@ -224,13 +224,14 @@ def compare(args) -> int:
 
 def diagnose(args) -> int:
     from .criticism.diagnose import diagnose as run_diagnose
-    from .io.atomic import save_figure, write_json
+    from .io.atomic import write_json
     from .physics.registry import registry
-    from .report.inversion_figures import residual_figure
+    from .report.diagnose_report import significance_statement, write_diagnose_report
+
+    from .infer.prior_set import read_prior_file
 
     model = build_model(args.model)
-    if args.prior:
-        raise ParameterError("diagnose uses each effect's default priors; --prior is not supported yet")
+    priors = read_prior_file(args.prior) if args.prior else None
     for name in args.candidates or []:
         registry.get(name)
     if args.top < 1:
@@ -238,24 +239,22 @@ def diagnose(args) -> int:
     data = load_dataset(args)
     observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
     report = run_diagnose(data, model, np.random.default_rng(args.seed), seed=args.seed, observables=observables,
-                          candidates=args.candidates, top=args.top)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    base = report.pop("_base")
-    save_figure(residual_figure(base.posterior, base.result), out / "residuals_base.png")
-    for c in report.pop("_confirmed"):
-        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), out / f"residuals_{c['effect']}.png")
+                          candidates=args.candidates, top=args.top, priors=priors)
+    base, confirmed = report.pop("_base"), report.pop("_confirmed")
+    write_diagnose_report(report, base, confirmed, Path(args.out), str(args.data))
     write_json(args.json, report)
     lead = report["ranking"][0] if report["ranking"] else None
     print(f"verdict: {report['verdict']}" + (f" ({lead['effect']}: delta ELPD {lead['delta_elpd']:+.1f} +- "
                                              f"{lead['delta_elpd_se']:.1f})" if lead and lead["delta_elpd"] is not None else ""))
-    print(f"wrote {args.json} and residual figures in {out}")
+    print(report["conclusion"])
+    print(significance_statement(report))
+    print(f"wrote {args.json}; figures and report.html in {args.out}")
     return 0
 
 
 def ladder(args) -> int:
-    from .criticism.ladder import climb, ladder_figure
-    from .io.atomic import atomic_path, save_figure, write_json
+    from .criticism.ladder import climb
+    from .report.ladder_report import write_ladder_report
 
     model = build_model(args.model)
     current = model
@@ -265,17 +264,7 @@ def ladder(args) -> int:
     observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
     rungs = climb(data, model, args.add, seed=args.seed, observables=observables)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    save_figure(ladder_figure(rungs), out / "ladder.png")
-    public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rungs]
-    write_json(args.json or out / "ladder.json", {"rungs": public})
-    lines = ["| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO | R-hat max |", "|---|---|---|---|---|---|"]
-    for i, r in enumerate(public):
-        rmse = "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}"
-        lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} | {r['rhat_max']:.3f} |")
-    with atomic_path(out / "ladder.md") as tmp:
-        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    print("\n".join(lines))
+    print("\n".join(write_ladder_report(rungs, out, args.json)))
     print(f"wrote {args.json or out / 'ladder.json'}, {out / 'ladder.png'}, {out / 'ladder.md'}")
     return 0
 

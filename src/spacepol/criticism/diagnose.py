@@ -16,10 +16,9 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import loo
-from ..infer.engines.de import run_de
-from ..infer.inference_data import to_inference_data
+from ..infer.inference_data import median_fit, standardise
 from ..infer.inversion import invert
-from ..infer.objective import NegativeLogPosterior
+from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
@@ -49,31 +48,76 @@ def _candidates(model: Model, data, names=None):
     return out
 
 
-def _screen(posterior, rng, budget):
-    res = run_de(NegativeLogPosterior(posterior), rng, max_evaluations=budget, popsize=10, polish=True)
-    return -res.objective
+def _build(data, model, observables, priors):
+    """The posterior of ``model`` with those prior overrides that name its parameters (or nuisances)."""
+    probe = Posterior.build(data, model, observables=observables)
+    own = {p.name for p in probe.priors.parameters}
+    return Posterior.build(data, model, {k: v for k, v in (priors or {}).items() if k in own}, observables=observables)
+
+
+def check_prior_names(data, model: Model, priors: dict, observables=None, candidates=None) -> None:
+    """Every overridden prior must belong to the base model or to one of the candidates."""
+    known = {p.name for p in Posterior.build(data, model, observables=observables).priors.parameters}
+    for _, candidate in _candidates(model, data, candidates):
+        known |= {p.name for p in candidate.parameters}
+    unknown = sorted(set(priors or {}) - known)
+    if unknown:
+        raise SpacepolError(f"--prior: no parameter(s) {', '.join(unknown)} in {model.name} or any candidate effect")
+
+
+def _screen(posterior, rng, budget, seeds=None):
+    value, theta = find_optimum(posterior, rng, evaluations=budget, seeds=seeds)
+    return value, dict(zip(posterior.priors.names, theta))
+
+
+def _nested_seeds(base_best: dict, candidate, posterior) -> np.ndarray:
+    """Start points of M + E at M's optimum: E's own parameters at their prior's lower end, default,
+    upper end and middle (most effects vanish at one of them: rho_pd = 0, e = 1, delta = 0, ...);
+    a parameter that splits one of M's (sigma -> sigma_x, sigma_y) starts at its value."""
+    params = {p.name: p for p in candidate.parameters}
+    rows = []
+    for option in range(4):
+        row = []
+        for name in posterior.priors.names:
+            if name in base_best:
+                row.append(base_best[name])
+                continue
+            split = [r for r in base_best if name.startswith(r + "_")]
+            lo, hi = posterior.priors.priors[name].bounds
+            default = params[name].default if name in params else 0.5 * (lo + hi)
+            row.append(base_best[split[0]] if split else [lo, default, hi, 0.5 * (lo + hi)][option])
+        rows.append(row)
+    return np.clip(np.array(rows), posterior.priors.bounds[:, 0], posterior.priors.bounds[:, 1])
 
 
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
-             top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True) -> dict:
-    base_post = Posterior.build(data, model, observables=observables)
-    if progress:
-        print(f"  fitting {model.name} ...", flush=True)
-    base = invert(base_post, seed=seed, max_steps=max_steps, progress=False)
+             top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
+             priors: dict | None = None, base=None) -> dict:
+    """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
+    ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted)."""
+    check_prior_names(data, model, priors, observables, candidates)
+    base_post = _build(data, model, observables, priors)
+    if base is None:
+        if progress:
+            print(f"  fitting {model.name} ...", flush=True)
+        base = invert(base_post, seed=seed, max_steps=max_steps, progress=False)
     base_loo = base.loo["pointwise"]
-    base_best = _screen(base_post, rng, screening_evaluations)
+    base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
 
     screened = []
     for name, candidate in _candidates(model, data, candidates):
-        post = Posterior.build(data, candidate, observables=observables)
-        gain = _screen(post, rng, screening_evaluations) - base_best
+        post = _build(data, candidate, observables, priors)
+        best, _ = _screen(post, rng, screening_evaluations, seeds=_nested_seeds(base_optimum, candidate, post))
+        gain = best - base_best
         screened.append({"effect": name, "model": candidate, "posterior": post, "screening_gain": float(gain)})
         if progress:
             print(f"  screening {name:<18s} max log posterior gain {gain:9.2f}", flush=True)
     screened.sort(key=lambda c: -c["screening_gain"])
 
+    # a candidate whose screening gain equals the leader's may be its twin: confirm it too
+    to_confirm = screened[:top] + [c for c in screened[top:] if screened and _close(c["screening_gain"], screened[0]["screening_gain"])]
     confirmed = []
-    for c in screened[:top]:
+    for c in to_confirm:
         if progress:
             print(f"  confirming {c['effect']} with emcee ...", flush=True)
         inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False)
@@ -91,7 +135,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["screening_gain"] = c["screening_gain"]
         entry["explanation"] = _explain(c, base)
         ranking.append(entry)
-    for c in screened[top:]:
+    for c in screened[len(to_confirm):]:
         ranking.append({"effect": c["effect"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
                         "significant": False, "screening_gain": c["screening_gain"],
                         "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."})
@@ -108,12 +152,73 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                                               f"here; {sep} would separate them.")
     return {"model": model.name, "fit": base.summary["fit"], "ranking": ranking, "verdict": verdict,
             "residual_structure": base.summary["residual_structure"]["findings"],
+            "conclusion": _conclusion(base, confirmed, verdict),
             "_base": base, "_confirmed": confirmed}
 
 
+def signatures(base, inv) -> dict:
+    """Per observable: the base fit's standardised residuals, and what the candidate changes in the
+    prediction in the same noise units (its signature), their correlation and the share of the
+    base chi^2 the candidate removes."""
+    data = base.posterior.likelihood.data
+    mu0, scale = median_fit(base.posterior, base.result.flat_samples())
+    mu1, _ = median_fit(inv.posterior, inv.result.flat_samples())
+    out = {}
+    for o in base.posterior.likelihood.observables:
+        observed = standardise(data, o, mu0[o], scale[o])
+        remaining = standardise(data, o, mu1[o], scale[o])
+        signature = observed - remaining
+        corr = float(np.corrcoef(observed, signature)[0, 1]) if np.std(signature) > 0 and np.std(observed) > 0 else 0.0
+        out[o] = {"observed": observed, "signature": signature, "correlation": corr,
+                  "chi2_removed": float(1 - np.sum(remaining**2) / max(np.sum(observed**2), 1e-300))}
+    return out
+
+
+def _where(data, observed) -> str:
+    """Where the base misfit is largest, in words."""
+    worst = np.argsort(-np.abs(observed))[:max(3, len(observed) // 10)]
+    tr, ti = data.theta_r[worst], data.theta_i[worst]
+    return (f"theta_i {ti.min():.0f}-{ti.max():.0f} deg, theta_r {tr.min():.0f}-{tr.max():.0f} deg, "
+            f"residuals mostly {'positive' if np.mean(observed[worst]) > 0 else 'negative'}")
+
+
+def _close(a: float, b: float) -> bool:
+    """Screening gains equal within the optimiser's reach (1 unit of log posterior, or 1 %)."""
+    return abs(a - b) < 1.0 + 0.01 * max(abs(a), abs(b))
+
+
+def _structured(summary) -> bool:
+    """Residuals still carry structure: misfit above the noise floor, or runs/trends flagged."""
+    return summary["fit"]["chi2_red"] > 1.5 or summary["residual_structure"]["structured"]
+
+
+def _conclusion(base, confirmed, verdict) -> str:
+    """One paragraph: what to add, and whether the library can explain what remains."""
+    if verdict == "none":
+        if _structured(base.summary):
+            return ("No candidate in the library improves ELPD-LOO by more than 2 SE, yet the residuals of "
+                    f"{base.summary['model']} are structured (reduced chi^2 {base.summary['fit']['chi2_red']:.2f}; "
+                    "see residual_structure): an effect outside the library is likely. Write it as a plug-in "
+                    "effect and rerun diagnose.")
+        return (f"No candidate improves ELPD-LOO by more than 2 SE, and the residuals of {base.summary['model']} "
+                "look like noise: nothing is missing at this noise level.")
+    after = next(c for c in confirmed if c["effect"] == verdict)["inversion"].summary
+    text = f"Add {verdict}: it is the candidate that improves ELPD-LOO most, by more than 2 SE."
+    if _structured(after):
+        text += (f" After adding it the residuals are still structured (reduced chi^2 {after['fit']['chi2_red']:.2f}"
+                 + "; " + " ".join(after["residual_structure"]["findings"])
+                 + "): run diagnose again on the extended model; if nothing else in the library helps, the rest comes "
+                 "from an effect outside it.")
+    else:
+        text += f" After adding it the residuals look like noise (reduced chi^2 {after['fit']['chi2_red']:.2f})."
+    return text
+
+
 def _tied(a, b) -> bool:
+    """Equal predictive performance within noise: |delta ELPD| < 2 SE of the difference, or < 4
+    (below 4 the difference is not worth a standard error; Sivula, Magnusson & Vehtari 2020)."""
     diff = a["pointwise"] - b["pointwise"]
-    return abs(diff.sum()) < np.sqrt(len(diff) * np.var(diff))
+    return abs(diff.sum()) < max(2 * np.sqrt(len(diff) * np.var(diff)), 4.0)
 
 
 def _explain(c, base) -> str:
@@ -122,5 +227,10 @@ def _explain(c, base) -> str:
     rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c["rmse_dop_after"]
     change = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
     verdict = "significant" if c["significant"] else "not significant (gain within 2 SE)"
+    why = []
+    data = base.posterior.likelihood.data
+    for o, s in signatures(base, c["inversion"]).items():
+        why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
+                   f"correlates {s['correlation']:+.2f} with the residuals and removes {100 * s['chi2_removed']:.0f} % of their chi^2")
     return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
-            f"{change}")
+            f"{change}" + "; ".join(why) + ".")

@@ -43,6 +43,11 @@ class ResidualReport:
                     out.append(f"{o}: residuals trend with {var} (Spearman rho = {t['rho']:+.2f}, p = {t['p']:.1g}).")
         return out or ["No structure in the residuals at the 1 % level: consistent with noise."]
 
+    def structured(self, alpha: float = 0.01) -> bool:
+        """Any runs or trend test significant after a Bonferroni correction over all the tests."""
+        p = [self.runs[o]["p"] for o in self.observables] + [t["p"] for o in self.observables for t in self.trends[o].values()]
+        return bool(p) and min(p) * len(p) < alpha
+
 
 def sweeps(data) -> list[np.ndarray]:
     """Index arrays of the sweeps: theta_r in order at fixed (theta_i, side of the specular plane)."""

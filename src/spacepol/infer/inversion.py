@@ -93,5 +93,6 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     from ..criticism.residuals import analyse
 
     structure = analyse(posterior, result.flat_samples())
-    summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings()}
+    summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
+                                     "structured": structure.structured()}
     return Inversion(posterior, result, idata, summary, loo_result, ident)

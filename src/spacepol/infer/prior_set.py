@@ -134,6 +134,12 @@ class PriorSet:
         u = np.atleast_2d(u)
         return np.column_stack([self.priors[n].rescale(u[:, j]) for j, n in enumerate(self.names)])
 
+    def to_unit(self, theta) -> np.ndarray:
+        """Inverse of ``rescale`` (to ~1e-4 in u, by interpolating each monotone prior transform)."""
+        theta = np.atleast_2d(theta)
+        grid = np.linspace(0.0, 1.0, 10001)
+        return np.column_stack([np.interp(theta[:, j], self.priors[n].rescale(grid), grid) for j, n in enumerate(self.names)])
+
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         return self.rescale(rng.uniform(size=(size, self.ndim)))
 

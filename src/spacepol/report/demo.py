@@ -3,9 +3,12 @@
 1. Forward model on the geometry of NIST's measured PTFE Mueller BRDF (0.633 um, plane of
    incidence): ``ptfe_forward.csv``, ``ptfe_dop.png``.
 2. Bayesian inversion of that measurement (DOP and BRDF) with the paper's model, compared with
-   PTFE's known bulk index (about 1.35): ``ptfe_paper/`` (summary.json, posterior.nc, corner,
-   fit and residual plots, report.html).
-3. ``report.html`` links them and says what was found.
+   PTFE's known bulk index (about 1.35): ``ptfe_paper/``.
+3. Model criticism on a bundled synthetic set with a hidden effect: fit -> diagnose -> ladder
+   (``hidden/``), then the hidden truth revealed.
+4. The same on PTFE (``ptfe_diagnose/``, ``ptfe_ladder/``): which effects improve ELPD-LOO by
+   more than 2 SE, and the error falling as they are added.
+5. ``report.html`` links them and says what was found.
 """
 
 from __future__ import annotations
@@ -14,7 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
+import json
+
+from ..criticism.diagnose import diagnose
+from ..criticism.ladder import climb
 from ..infer.inversion import invert
+from ..io.atomic import write_json
 from ..infer.posterior import Posterior
 from ..io import read_measurements, write_table
 from ..paths import bundled
@@ -22,6 +30,8 @@ from ..physics.geometry import Geometry
 from ..physics.model import Model
 from . import html as H
 from .figures import dop_versus_theta_r
+from .diagnose_report import significance_statement, write_diagnose_report
+from .ladder_report import write_ladder_report
 from .run_report import write_run_report
 
 # Sintered PTFE: bulk index ~1.35, non-absorbing, very rough, mostly volume scattering.
@@ -59,16 +69,47 @@ def forward_comparison(data, out: Path) -> list[str]:
     return lines
 
 
+def criticise(data, base, out: Path, label: str, seed: int, max_additions: int = 2) -> tuple[dict, list[dict]]:
+    """diagnose (reusing the base fit), then a ladder adding the verdict and the next significant,
+    non-twin effects; writes ``out/diagnose/`` and ``out/ladder/``."""
+    model = base.posterior.likelihood.model
+    report = diagnose(data, model, np.random.default_rng(seed), seed=seed, base=base)
+    base, confirmed = report.pop("_base"), report.pop("_confirmed")
+    write_diagnose_report(report, base, confirmed, out / "diagnose", label)
+    write_json(out / "diagnose.json", report)
+    additions = []
+    if report["verdict"] != "none":
+        twins = set(report["ranking"][0].get("tied_with", []))
+        additions = [r["effect"] for r in report["ranking"] if r["significant"] and r["effect"] not in twins][:max_additions]
+    fitted = {base.summary["model"]: base} | {c["inversion"].summary["model"]: c["inversion"] for c in confirmed}
+    rungs = climb(data, model, additions, seed=seed, fitted=fitted)
+    write_ladder_report(rungs, out / "ladder")
+    return report, rungs
+
+
+def _criticism_section(report, rungs, folder: str) -> str:
+    public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rungs]
+    rows = [[r["model"], "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}", f"{r['chi2_red']:.2f}",
+             f"{r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f}"] for r in public]
+    return (H.paragraph(f"verdict: {report['verdict']}. {report['conclusion']}") + H.paragraph(significance_statement(report))
+            + H.table(["model", "RMSE(DOP)", "reduced chi^2", "ELPD-LOO"], rows)
+            + H.image(H.png_file_to_data_uri(Path(folder) / "ladder" / "ladder.png"),
+                      "The ladder: residuals per rung (top) and reduced chi^2 / ELPD-LOO per rung (bottom).")
+            + H.image(H.png_file_to_data_uri(Path(folder) / "diagnose" / "signatures.png"),
+                      "Residuals of the base fit (dots) and each candidate's signature (crosses).")
+            + f'<p><a href="{Path(folder).name}/diagnose/report.html">Full diagnosis</a></p>')
+
+
 def run_demo(out: Path, seed: int = 0) -> None:
     out.mkdir(parents=True, exist_ok=True)
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
     data = read_measurements(source).at_wavelength(0.633).in_plane()
-    print(f"1/2 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
+    print(f"1/4 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
     forward_lines = forward_comparison(data, out)
     for line in forward_lines:
         print("   " + line)
 
-    print("2/2 inversion of the PTFE measurement (DOP + BRDF) with the paper's model")
+    print("2/4 inversion of the PTFE measurement (DOP + BRDF) with the paper's model")
     posterior = Posterior.build(data, Model.from_string("paper"))
     inv = invert(posterior, seed=seed, backend_path=None, progress=True)
     summary = write_run_report(inv, out / "ptfe_paper", f"{source} (0.633 um, in-plane)", references={"n": PTFE_INDEX})
@@ -77,10 +118,26 @@ def run_demo(out: Path, seed: int = 0) -> None:
     print(f"   n = {n['median']:.3f} [90 %: {n['q05']:.3f}, {n['q95']:.3f}] against PTFE's bulk index {PTFE_INDEX}; "
           f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}")
 
+    hidden_path = bundled("synthetic", "hidden_effect.csv")
+    truth = json.loads(bundled("synthetic", "hidden_effect_truth.json").read_text())
+    print(f"3/4 what is missing? fit -> diagnose -> ladder on {hidden_path.name} (a synthetic set with a hidden effect)")
+    hidden = read_measurements(hidden_path)
+    hidden_base = invert(Posterior.build(hidden, Model.from_string("paper")), seed=seed, progress=False)
+    hidden_report, hidden_rungs = criticise(hidden, hidden_base, out / "hidden", str(hidden_path), seed)
+    found = "found" if hidden_report["verdict"] == truth["hidden_effect"] or truth["hidden_effect"] in \
+        hidden_report["ranking"][0].get("tied_with", []) else "NOT found"
+    print(f"   verdict {hidden_report['verdict']}; the hidden effect was {truth['hidden_effect']} ({found})")
+
+    print("4/4 what is missing from the paper's model on PTFE? diagnose -> ladder")
+    ptfe_report, ptfe_rungs = criticise(data, inv, out / "ptfe", f"{source} (0.633 um, in-plane)", seed)
+    print("   " + significance_statement(ptfe_report))
+
     sections = [
         ("What this is", H.paragraph(
             "spacepol's demo on NIST's measured Mueller-matrix BRDF of sintered PTFE (Germer, Appl. Opt. 56, 2017), "
-            "0.633 um, plane of incidence: the forward model, then a Bayesian inversion of DOP and BRDF.")),
+            "0.633 um, plane of incidence: the forward model, a Bayesian inversion of DOP and BRDF, then model criticism "
+            "(what is missing from the paper's model, and the error falling as it is added), first on a synthetic set "
+            "with a known hidden effect, then on PTFE.")),
         ("1. Forward model", H.bullets(forward_lines) + H.image(H.png_file_to_data_uri(out / "ptfe_dop.png"))),
         ("2. Inversion with the paper's model", H.bullets(
             [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
@@ -92,6 +149,12 @@ def run_demo(out: Path, seed: int = 0) -> None:
          + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),
                    "Residuals: the BRDF's U shape is the paper's cos(theta_r) body term failing a nearly Lambertian "
                    "material; DOP residuals lean positive where DOP is small (noise bias of a measured DOP).")),
+        ("3. A hidden effect, found and closed", H.paragraph(
+            f"{hidden_path.name}: {len(hidden)} synthetic geometries from the paper's model plus one hidden effect "
+            f"({truth['description']}). diagnose sees only the data.")
+         + _criticism_section(hidden_report, hidden_rungs, out / "hidden")
+         + H.paragraph(f"Revealed: the hidden effect was {truth['hidden_effect']} with {truth['hidden_parameters']} ({found}).")),
+        ("4. What the paper's model misses on PTFE", _criticism_section(ptfe_report, ptfe_rungs, out / "ptfe")),
     ]
     (out / "report.html").write_text(H.page("spacepol demo: PTFE", sections), encoding="utf-8")
-    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/)")
+    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/)")

@@ -11,7 +11,10 @@ from ..result import History
 
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,
-           popsize: int = 15, tol: float = 1e-8, seed: int | None = None, polish: bool = True) -> Result:
+           popsize: int = 15, tol: float = 1e-8, seed: int | None = None, polish: bool = True,
+           seeds=None) -> Result:
+    """``seeds``: parameter vectors (S, D) placed in the initial population (DE is elitist, so the
+    result is never worse than the best of them)."""
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim
     history = History()
@@ -24,9 +27,17 @@ def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evalua
         return values
 
     maxiter = max(1, max_evaluations // (popsize * ndim) - 1)
+    init = "latinhypercube"
+    de_rng = np.random.default_rng(rng.integers(2**63))
+    if seeds is not None:
+        from scipy.stats import qmc
+
+        init = qmc.LatinHypercube(d=ndim, rng=de_rng).random(popsize * ndim)
+        seeds_u = priors.to_unit(np.atleast_2d(seeds))[: len(init) - 1]
+        init[: len(seeds_u)] = np.clip(seeds_u, 0.0, 1.0)
     res = differential_evolution(
         f, bounds=[(0.0, 1.0)] * ndim, maxiter=maxiter, popsize=popsize, tol=tol,
-        rng=np.random.default_rng(rng.integers(2**63)), vectorized=True, updating="deferred", polish=False,
+        rng=de_rng, vectorized=True, updating="deferred", polish=False, init=init,
     )
     best_u = np.clip(res.x, 0, 1)
     if polish:

@@ -29,7 +29,6 @@ from pathlib import Path
 import emcee
 import numpy as np
 
-from ..objective import NegativeLogPosterior
 from ..result import Result
 
 
@@ -47,12 +46,10 @@ def default_walkers(ndim: int) -> int:
 
 
 def initial_ball(posterior, rng, walkers, init_evaluations=3000):
-    """Walkers around a quick DE optimum; each inside the prior with finite log posterior."""
-    from .de import run_de
+    """Walkers around the global optimum (``infer.optimum``); each inside the prior with finite log posterior."""
+    from ..optimum import find_optimum
 
-    objective = NegativeLogPosterior(posterior)
-    quick = run_de(objective, rng, max_evaluations=init_evaluations, popsize=10, polish=True)
-    centre = quick.best_vector()
+    _, centre = find_optimum(posterior, rng, evaluations=init_evaluations)
     width = np.diff(posterior.priors.bounds, axis=1).ravel()
     width = np.where(np.isfinite(width), width, 1.0)
     ball = centre + 1e-3 * width * rng.standard_normal((walkers, posterior.ndim))
@@ -60,7 +57,7 @@ def initial_ball(posterior, rng, walkers, init_evaluations=3000):
     ball = np.clip(ball, lo + 1e-9 * width, hi - 1e-9 * width)
     bad = ~np.isfinite(posterior.log_prob(ball))
     ball[bad] = centre
-    return ball, quick
+    return ball
 
 
 def _kept(sampler, tau):
@@ -105,7 +102,6 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             backend.reset(walkers, ndim)
 
     sampler = emcee.EnsembleSampler(walkers, ndim, posterior.log_prob, vectorize=True, moves=_moves(), backend=backend)
-    init_info = {}
     if resumed:
         state = None
         if progress:
@@ -113,8 +109,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     else:
         sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
         if initial is None:
-            initial, quick = initial_ball(posterior, rng, walkers)
-            init_info = {"init_evaluations": quick.n_evaluations}
+            initial = initial_ball(posterior, rng, walkers)
         elif isinstance(initial, str) and initial == "prior":
             initial = posterior.priors.sample(rng, walkers)
         state = initial
@@ -147,7 +142,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         "steps": int(sampler.iteration), "walkers": walkers, "burn_in": burn, "thin": thin,
         "tau": [float(t) for t in tau], "tau_max": tau_max,
         "acceptance": float(np.mean(sampler.acceptance_fraction)), "capped": capped,
-        "resumed": resumed, "moves": "DE", **init_info,
+        "resumed": resumed, "moves": "DE",
     }
     return Result(
         method="emcee", model=model_name, names=list(posterior.names),

@@ -1,0 +1,75 @@
+"""Figures of model criticism: does a candidate effect's signature match the observed misfit?"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..criticism.diagnose import signatures
+from ..infer.inference_data import standardised_residuals
+
+
+def _signed_theta_r(data):
+    """theta_r with a sign: + on the specular side (|dphi| > 90 deg), - on the source side."""
+    return np.where(np.cos(np.radians(data.dphi)) < 0, data.theta_r, -data.theta_r)
+
+
+def signature_figure(base, candidates, fig=None) -> Figure:
+    """Observed residuals of the base fit (dots) against each candidate's signature (crosses).
+
+    ``base`` is the base model's Inversion, ``candidates`` a list of (effect name, Inversion of
+    base + effect). The signature of a candidate is what it changes in the prediction, in noise
+    units: (posterior-median prediction of M + E) - (that of M), divided by the noise. Where the
+    crosses follow the dots, the effect explains the misfit.
+    """
+    data, observables = base.posterior.likelihood.data, base.posterior.likelihood.observables
+    x = _signed_theta_r(data)
+    fig = fig or Figure(figsize=(3.3 * max(len(candidates), 1) + 0.8, 2.8 * len(observables)), layout="constrained")
+    axes = fig.subplots(len(observables), max(len(candidates), 1), squeeze=False, sharex=True)
+    for j, (name, inv) in enumerate(candidates):
+        sig = signatures(base, inv)
+        for i, o in enumerate(observables):
+            ax = axes[i, j]
+            ax.scatter(x, sig[o]["observed"], s=9, c=data.theta_i, cmap="viridis", label="observed residual")
+            ax.scatter(x, sig[o]["signature"], s=14, marker="x", c="C3", lw=0.8, label=f"signature of {name}")
+            ax.axhline(0, color="k", lw=0.6)
+            ax.set_title(f"{name}: {o} (correlation {sig[o]['correlation']:+.2f})", fontsize=8)
+            if j == 0:
+                ax.set_ylabel(f"{o}: residual / noise")
+            if i == len(observables) - 1:
+                ax.set_xlabel("theta_r (deg), + specular side")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle("Does the candidate change the prediction where the base model misses? (colour: theta_i)", fontsize=9)
+    return fig
+
+
+def ladder_figure(rungs, fig=None) -> Figure:
+    """Top: DOP residual / noise against theta_r for every rung; bottom: RMSE, chi2_red, ELPD per rung."""
+    fig = fig or Figure(figsize=(3.2 * len(rungs) + 1, 6.0), layout="constrained")
+    grid = fig.add_gridspec(2, len(rungs))
+    for i, rung in enumerate(rungs):
+        inv = rung["_inversion"]
+        ax = fig.add_subplot(grid[0, i])
+        obs = inv.posterior.likelihood.observables[0]
+        z = standardised_residuals(inv.posterior, inv.result.flat_samples())[obs]
+        data = inv.posterior.likelihood.data
+        ax.scatter(_signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
+        ax.axhline(0, color="k", lw=0.8)
+        for level in (-2, 2):
+            ax.axhline(level, color="k", lw=0.5, ls=":")
+        ax.set_title(rung["model"].replace("+", "\n+"), fontsize=7)
+        ax.set_xlabel("theta_r (deg)", fontsize=8)
+        if i == 0:
+            ax.set_ylabel(f"{obs} residual / noise")
+    ax = fig.add_subplot(grid[1, :])
+    x = np.arange(len(rungs))
+    ax.plot(x, [r["chi2_red"] for r in rungs], "o-", label="reduced chi^2")
+    ax.axhline(1, color="k", lw=0.5, ls=":")
+    ax.set_yscale("log")
+    ax.set_xticks(x, [r["model"].split("+")[-1] if i else r["model"] for i, r in enumerate(rungs)], fontsize=8)
+    ax.set_ylabel("reduced chi^2")
+    ax2 = ax.twinx()
+    ax2.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s--", color="C1", label="ELPD-LOO")
+    ax2.set_ylabel("ELPD-LOO", color="C1")
+    ax.set_title("each rung adds one effect: the error falls towards the noise floor (chi^2 = 1)", fontsize=9)
+    return fig

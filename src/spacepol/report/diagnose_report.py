@@ -1,0 +1,64 @@
+"""Files of ``invert-mcmc diagnose``: residual figures, the signature figure, report.html."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..io.atomic import atomic_path, save_figure
+from . import html as H
+from .criticism_figures import signature_figure
+from .inversion_figures import residual_figure
+
+
+def ranking_rows(report: dict) -> list[list]:
+    rows = []
+    for r in report["ranking"]:
+        confirmed = r["delta_elpd"] is not None
+        rows.append([r["effect"], f"{r['screening_gain']:+.1f}",
+                     f"{r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f}" if confirmed else "not refitted",
+                     f"{r['rmse_dop_after']:.4f}" if confirmed and r["rmse_dop_after"] is not None else "",
+                     ("yes" if r["significant"] else "no") + (f" (tied with {', '.join(r['tied_with'])})" if r.get("tied_with") else "")])
+    return rows
+
+
+def significance_statement(report: dict) -> str:
+    """Which candidates improve ELPD-LOO by more than 2 SE and which do not, in one sentence."""
+    confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]
+    yes = [f"{r['effect']} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if r["significant"]]
+    no = [f"{r['effect']} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if not r["significant"]]
+    screened = [r["effect"] for r in report["ranking"] if r["delta_elpd"] is None]
+    text = ("Improve ELPD-LOO by more than 2 SE: " + (", ".join(yes) if yes else "none") + ". Do not: "
+            + (", ".join(no) if no else "none of the refitted candidates"))
+    if screened:
+        text += "; screened out before refitting (their best fit gains too little): " + ", ".join(screened)
+    return text + "."
+
+
+def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, data_label: str) -> dict[str, Path]:
+    """Write the figures and report.html into ``out``; returns the figure paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"base": out / "residuals_base.png", "signatures": out / "signatures.png"}
+    save_figure(residual_figure(base.posterior, base.result), paths["base"])
+    for c in confirmed:
+        paths[c["effect"]] = out / f"residuals_{c['effect']}.png"
+        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["effect"]])
+    save_figure(signature_figure(base, [(c["effect"], c["inversion"]) for c in confirmed]), paths["signatures"])
+    fit = report["fit"]
+    sections = [
+        ("Data and base model", H.paragraph(
+            f"{data_label}; base model {report['model']}: RMSE(DOP) {fit['rmse_dop'] if fit['rmse_dop'] is None else round(fit['rmse_dop'], 5)}, "
+            f"reduced chi^2 {fit['chi2_red']:.2f}, ELPD-LOO {fit['elpd_loo']:.1f} +- {fit['elpd_loo_se']:.1f}.")
+         + H.bullets(report["residual_structure"])),
+        ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
+        ("Ranking", H.table(["effect", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
+                             "significant (> 2 SE)"], ranking_rows(report))
+         + H.bullets([f"{r['effect']}: {r['explanation']}" for r in report["ranking"] if r["delta_elpd"] is not None])),
+        ("Signatures", H.image(H.png_file_to_data_uri(paths["signatures"]),
+                               "Dots: residuals of the base fit / noise. Crosses: what each candidate changes in the "
+                               "prediction, in the same units. A candidate that explains the misfit follows the dots.")),
+        ("Residuals of the base fit", H.image(H.png_file_to_data_uri(paths["base"]))),
+    ]
+    with atomic_path(out / "report.html") as tmp:
+        tmp.write_text(H.page(f"spacepol diagnose: what is missing from {report['model']}", sections), encoding="utf-8")
+    return paths

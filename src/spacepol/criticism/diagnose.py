@@ -5,7 +5,7 @@
    M, a quick differential-evolution maximum of the log posterior of M + E; the gain over M's
    maximum (a likelihood-ratio statistic) ranks the candidates.
 3. Confirmation: the ``top`` candidates are refitted with emcee; the change in ELPD-LOO and its
-   standard error come from the pointwise LOO differences; significant = gain > 2 SE.
+   standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4.
 4. Twins: confirmed candidates whose pointwise LOO agree within noise (difference < 1 SE) are
    reported as tied; the explanation says what measurement separates them.
 """
@@ -125,7 +125,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
                  rmse_dop_after=inv.summary["fit"]["rmse_dop"])
-        c["significant"] = bool(c["delta_elpd"] > 2 * c["delta_elpd_se"] and c["delta_elpd"] > 0)
+        c["significant"] = significant(c["delta_elpd"], c["delta_elpd_se"])
         confirmed.append(c)
     confirmed.sort(key=lambda c: -c["delta_elpd"])
 
@@ -182,6 +182,16 @@ def _where(data, observed) -> str:
             f"residuals mostly {'positive' if np.mean(observed[worst]) > 0 else 'negative'}")
 
 
+MIN_DELTA_ELPD = 4.0
+
+
+def significant(delta: float, se: float) -> bool:
+    """delta ELPD-LOO > 2 SE and > 4: below 4 the SE of a difference is unreliable and the models
+    predict alike (Sivula, Magnusson & Vehtari 2020; Vehtari's cross-validation FAQ). Nested models
+    on pure noise otherwise give tiny deltas with tinier SEs."""
+    return bool(delta > 2 * se and delta > MIN_DELTA_ELPD)
+
+
 def _close(a: float, b: float) -> bool:
     """Screening gains equal within the optimiser's reach (1 unit of log posterior, or 1 %)."""
     return abs(a - b) < 1.0 + 0.01 * max(abs(a), abs(b))
@@ -196,11 +206,11 @@ def _conclusion(base, confirmed, verdict) -> str:
     """One paragraph: what to add, and whether the library can explain what remains."""
     if verdict == "none":
         if _structured(base.summary):
-            return ("No candidate in the library improves ELPD-LOO by more than 2 SE, yet the residuals of "
+            return ("No candidate in the library improves ELPD-LOO by more than 2 SE (and 4), yet the residuals of "
                     f"{base.summary['model']} are structured (reduced chi^2 {base.summary['fit']['chi2_red']:.2f}; "
                     "see residual_structure): an effect outside the library is likely. Write it as a plug-in "
                     "effect and rerun diagnose.")
-        return (f"No candidate improves ELPD-LOO by more than 2 SE, and the residuals of {base.summary['model']} "
+        return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary['model']} "
                 "look like noise: nothing is missing at this noise level.")
     after = next(c for c in confirmed if c["effect"] == verdict)["inversion"].summary
     text = f"Add {verdict}: it is the candidate that improves ELPD-LOO most, by more than 2 SE."
@@ -226,7 +236,7 @@ def _explain(c, base) -> str:
     physics = _first_sentence(cls.description)
     rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c["rmse_dop_after"]
     change = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
-    verdict = "significant" if c["significant"] else "not significant (gain within 2 SE)"
+    verdict = "significant" if c["significant"] else "not significant (gain within 2 SE or below 4)"
     why = []
     data = base.posterior.likelihood.data
     for o, s in signatures(base, c["inversion"]).items():

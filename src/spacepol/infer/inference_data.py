@@ -3,6 +3,8 @@ sample_stats, observed_data), so ArviZ computes R-hat, ESS and PSIS-LOO."""
 
 from __future__ import annotations
 
+import warnings
+
 import arviz as az
 import numpy as np
 
@@ -88,17 +90,19 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
 
     geometry = {"theta_i": ("geometry", lik.data.theta_i), "theta_r": ("geometry", lik.data.theta_r),
                 "dphi": ("geometry", lik.data.dphi)}
-    idata = az.from_dict(
-        posterior={name: shaped(flat[:, j]) for j, name in enumerate(posterior.names)},
-        posterior_predictive={o: shaped(r) for o, r in reps.items()},
-        log_likelihood={"y": shaped(loglik)},
-        sample_stats={"lp": shaped(result.log_prob.T.reshape(-1))},
-        observed_data=lik.observed(),
-        constant_data={k: v[1] for k, v in geometry.items()},
-        coords={"geometry": np.arange(n), "obs_id": lik.labels},
-        dims={**{o: ["geometry"] for o in lik.observables}, "y": ["obs_id"],
-              **{k: ["geometry"] for k in geometry}},
-    )
+    with warnings.catch_warnings():  # emcee's walkers are ArviZ's chains: few thinned draws per walker are normal
+        warnings.filterwarnings("ignore", message="More chains")
+        idata = az.from_dict(
+            posterior={name: shaped(flat[:, j]) for j, name in enumerate(posterior.names)},
+            posterior_predictive={o: shaped(r) for o, r in reps.items()},
+            log_likelihood={"y": shaped(loglik)},
+            sample_stats={"lp": shaped(result.log_prob.T.reshape(-1))},
+            observed_data=lik.observed(),
+            constant_data={k: v[1] for k, v in geometry.items()},
+            coords={"geometry": np.arange(n), "obs_id": lik.labels},
+            dims={**{o: ["geometry"] for o in lik.observables}, "y": ["obs_id"],
+                  **{k: ["geometry"] for k in geometry}},
+        )
     idata.posterior.attrs.update({
         "model": result.model, "method": result.method, "seed": result.seed,
         "walkers": result.info.get("walkers", chains), "burn_in": result.info.get("burn_in", 0),

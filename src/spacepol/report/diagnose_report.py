@@ -52,7 +52,7 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
          + H.bullets(report["residual_structure"])),
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
         ("Ranking", H.table(["effect", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
-                             "significant (> 2 SE)"], ranking_rows(report))
+                             "significant (> 2 SE and > 4)"], ranking_rows(report))
          + H.bullets([f"{r['effect']}: {r['explanation']}" for r in report["ranking"] if r["delta_elpd"] is not None])),
         ("Signatures", H.image(H.png_file_to_data_uri(paths["signatures"]),
                                "Dots: residuals of the base fit / noise. Crosses: what each candidate changes in the "

@@ -81,9 +81,25 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="FILE", help="write the rungs here (default DIR/ladder.json)")
     p.add_argument("--out", default="reports/ladder")
 
-    for name in ("sky", "contrast"):
-        p = sub.add_parser(name, help="(not yet available)")
-        p.add_argument("rest", nargs=argparse.REMAINDER)
+    p = sub.add_parser("sky", help="the sun (astropy) and the sky's polarization at a site and time; maps")
+    p.add_argument("--lat", type=float, required=True, metavar="DEG", help="latitude, north positive")
+    p.add_argument("--lon", type=float, required=True, metavar="DEG", help="longitude, east positive")
+    p.add_argument("--time", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2020-12-16T11:42+08:00")
+    p.add_argument("--model", default="rayleigh", choices=["rayleigh", "berry-dennis-lee"])
+    p.add_argument("--p-max", type=float, default=None, help="maximum DOP (default 1 for rayleigh, 0.8 for berry-dennis-lee)")
+    p.add_argument("--delta-deg", type=float, default=20.0, help="berry-dennis-lee: neutral points' distance from the sun")
+    p.add_argument("--direction", action="append", default=[], metavar="ZENITH,AZIMUTH",
+                   help="a direction (deg) at which to report DOP and AoP (repeatable)")
+    p.add_argument("--out", default="reports/sky")
+
+    p = sub.add_parser("contrast", help="Table 3 as distributions from the posterior of a run")
+    p.add_argument("run_dir", metavar="RUN_DIR", help="the --out folder of `invert-mcmc run`")
+    p.add_argument("--scenario", metavar="FILE.toml", help="default: the paper's section 4 and Table 2")
+    p.add_argument("--reading", default="corrected", choices=["corrected", "paper"],
+                   help="micro-polarizer: superpixel mean 1/2 (corrected) or (1 + P)/2 (paper)")
+    p.add_argument("--draws", type=int, default=20000)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", default=None, help="default: RUN_DIR/contrast")
     for p in sub.choices.values():  # --effect also after the command name, where users put it
         p.add_argument("--effect", action="append", default=[], dest="effect_after", metavar="FILE.py:NAME",
                        help="load a user-defined effect (repeatable); it is then usable by name")

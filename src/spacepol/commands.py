@@ -269,8 +269,95 @@ def ladder(args) -> int:
     return 0
 
 
-def _not_yet(args) -> int:
-    raise SpacepolError(f"'{args.command}' is not available yet in this version")
+def _parse_direction(text: str) -> tuple[float, float]:
+    try:
+        zen, az = (float(v) for v in text.split(","))
+    except ValueError:
+        raise ParameterError(f"--direction '{text}': expected ZENITH,AZIMUTH in degrees, e.g. 60,101.5") from None
+    if not 0 <= zen <= 90:
+        raise ParameterError(f"--direction '{text}': zenith angle must lie in [0, 90] deg")
+    return zen, az
 
 
-sky = contrast = _not_yet
+def sky(args) -> int:
+    from .io.atomic import save_figure, write_json
+    from .report.sky_figures import projection_distortion_figure, sky_maps_figure
+    from .sky.neutral_points import BerryDennisLeeSky
+    from .sky.projections import PROJECTIONS, cap_fraction
+    from .sky.rayleigh import RayleighSky
+    from .sky.sun import sun_position
+
+    directions = [_parse_direction(d) for d in args.direction]
+    if args.model == "rayleigh":
+        model = RayleighSky(1.0 if args.p_max is None else args.p_max)
+    else:
+        model = BerryDennisLeeSky(0.8 if args.p_max is None else args.p_max, args.delta_deg)
+    sun = sun_position(args.lat, args.lon, args.time)
+    s = (sun.zenith_deg, sun.azimuth_deg)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    report = {
+        "sun": {"zenith_deg": sun.zenith_deg, "azimuth_deg": sun.azimuth_deg, "altitude_deg": sun.altitude_deg,
+                "time_utc": sun.time_utc, "azimuth_convention": "degrees east of north", "refraction": "none"},
+        "site": {"lat_deg": args.lat, "lon_deg": args.lon, "time": args.time},
+        "model": {"name": model.name, "p_max": model.p_max} | ({"delta_deg": model.delta_deg} if args.model != "rayleigh" else {}),
+        "aop_frame": "angle of the E-vector from the local meridian (towards the zenith), positive towards increasing azimuth",
+        "directions": [{"zenith_deg": z, "azimuth_deg": a, "dop": float(model.dop(z, a, s)), "aop_deg": float(model.aop(z, a, s))}
+                       for z, a in directions],
+        "projections": {name: {"zenith_30_cap_share_of_map": cap_fraction(p, 30.0),
+                               "max_angular_distortion_deg": float(p.tissot(89.999)["angular_distortion_deg"]),
+                               "areal_scale_at_horizon": float(p.tissot(89.999)["areal_scale"])}
+                        for name, p in PROJECTIONS.items()},
+    }
+    points = {f"target {i + 1}": d for i, d in enumerate(directions)}
+    if args.model != "rayleigh":
+        report["neutral_points"] = {k: {"zenith_deg": z, "azimuth_deg": a} for k, (z, a) in model.neutral_points(s).items()}
+        points.update(model.neutral_points(s))
+    save_figure(sky_maps_figure(model, s, points), out / "sky_maps.png")
+    save_figure(projection_distortion_figure(), out / "projections.png")
+    write_json(out / "sky.json", report)
+    print(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg east of north ({sun.time_utc})")
+    for d in report["directions"]:
+        print(f"  zenith {d['zenith_deg']:g}, azimuth {d['azimuth_deg']:g}: DOP {d['dop']:.3f}, AoP {d['aop_deg']:.1f} deg")
+    print(f"wrote {out}/sky.json, sky_maps.png, projections.png")
+    return 0
+
+
+def contrast(args) -> int:
+    from .detect.contrast import propagate
+    from .detect.paper_table3 import recompute
+    from .detect.scenario import default_scenario, read_scenario
+    from .io.run_dir import load_run
+    from .report.contrast_report import table3_lines, write_contrast_report
+
+    scenario = read_scenario(args.scenario) if args.scenario else default_scenario()
+    if args.draws < 100:
+        raise ParameterError(f"--draws {args.draws}: need at least 100 for 90 % intervals")
+    spec, samples, summary = load_run(args.run_dir)
+    model = build_model(spec)
+    report = propagate(model, samples, scenario, np.random.default_rng(args.seed), draws=args.draws, reading=args.reading)
+    report["paper_table3"] = recompute(scenario.instrument)
+    report["model"] = spec
+    report["seed"] = args.seed
+    assumptions = contrast_assumptions(summary, scenario)
+    out = Path(args.out) if args.out else Path(args.run_dir) / "contrast"
+    write_contrast_report(report, out, str(args.run_dir), assumptions)
+    print("\n".join(table3_lines(report)))
+    print(report["dominance"])
+    print(f"wrote {out}/contrast.json, table3.md, contrast_histograms.png, report.html")
+    return 0
+
+
+def contrast_assumptions(summary: dict, scenario) -> list[str]:
+    t, sky_ = scenario.target, scenario.sky
+    return [
+        f"Target DOP from the posterior of {summary['model']} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "
+        f"theta_r uniform in [{t['theta_r_low_deg']:g}, {t['theta_r_high_deg']:g}] deg (the paper's Figure 9 range), "
+        "unless a case fixes theta_r_deg.",
+        "The material's posterior is used as measured; no dispersion to the 1.5-1.8 um band is modelled.",
+        f"Sky DOP from the {sky_['model']} model with P_max uniform in [{sky_['p_max_low']:g}, {sky_['p_max_high']:g}] "
+        "(a clear sky peaks near 0.7-0.8), sun from astropy for the scenario's site and time.",
+        f"Limiting magnitude from eq 39 (angstrom, per cm^2) at Phi_s = {scenario.instrument['limit_flux_photons_m2_s']:g} "
+        f"photons m^-2 s^-1; raw contrast against a sky of {scenario.instrument['sky_magnitude']:g} mag (implied by Table 3, "
+        "not stated in the paper).",
+    ]

@@ -84,6 +84,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "observables": posterior.likelihood.observables,
         "n_observations": posterior.likelihood.n_obs,
         "priors": posterior.priors.describe(),
+        "fixed": {k: float(v) for k, v in posterior.priors.fixed.items()},
         "map": result.best,
         "sampler": {k: v for k, v in result.info.items() if k != "tau"} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],

@@ -1,0 +1,72 @@
+"""Files of ``invert-mcmc contrast``: contrast.json, table3.md, contrast_histograms.png, report.html."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..io.atomic import atomic_path, save_figure, write_json
+from . import html as H
+from .sky_figures import contrast_histograms
+
+QUANTITIES = [("target_dop", "target DOP", "{:.3f}"), ("sky_dop", "sky DOP", "{:.3f}"),
+              ("limiting_magnitude", "limiting magnitude", "{:.2f}"), ("intensity_contrast", "raw intensity contrast", "{:.4f}"),
+              ("polarization_contrast", "polarization contrast", "{:.3f}")]
+
+
+def table3_lines(report: dict) -> list[str]:
+    head = "| case | " + " | ".join(label for _, label, _ in QUANTITIES) + " | spread dominated by |"
+    lines = [head, "|" + "---|" * (len(QUANTITIES) + 2)]
+    for row in report["rows"]:
+        cells = [f"{fmt.format(row[k]['median'])} [{fmt.format(row[k]['q05'])}, {fmt.format(row[k]['q95'])}]"
+                 for k, _, fmt in QUANTITIES]
+        lines.append(f"| {row['case']} | " + " | ".join(cells) + f" | {row['dominant_input']['polarization_contrast']} |")
+    return lines
+
+
+def dominance_paragraph(report: dict) -> str:
+    parts = []
+    for row in report["rows"]:
+        w = row["dominant_input"]["widths_90"]
+        order = sorted(w, key=lambda n: -w[n]["polarization_contrast"])
+        parts.append(f"{row['case']}: the 90 % width of the polarization contrast is {w[order[0]]['polarization_contrast']:.3f} "
+                     f"when only the {order[0]} varies, against {w[order[1]]['polarization_contrast']:.3f} ({order[1]}) and "
+                     f"{w[order[2]]['polarization_contrast']:.3f} ({order[2]}); the {order[0]} dominates.")
+    return " ".join(parts)
+
+
+def write_contrast_report(report: dict, out: Path, run_dir: str, assumptions: list[str]) -> None:
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    draws = report.pop("_draws")
+    report["dominance"] = dominance_paragraph(report)
+    report["assumptions"] = assumptions
+    save_figure(contrast_histograms(draws), out / "contrast_histograms.png")
+    lines = table3_lines(report)
+    with atomic_path(out / "table3.md") as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    write_json(out / "contrast.json", report)
+    rad = report["radiometry"]
+    rows = [[r["case"]] + [f"{r[k]['median']:.4g} [{r[k]['q05']:.4g}, {r[k]['q95']:.4g}]" for k, _, _ in QUANTITIES]
+            for r in report["rows"]]
+    paper = [[p["case"], f"{p['sky_dop']['paper']}", f"{p['limiting_magnitude']['paper']}",
+              f"{p['intensity_contrast']['paper']}", f"{p['polarization_contrast']['paper']}",
+              "; ".join(f"{k}: {'reproduced' if v['reproduced'] else 'not reproduced'}" for k, v in p.items() if isinstance(v, dict))]
+             for p in report["paper_table3"]]
+    sections = [
+        ("Posterior and scenario", H.paragraph(
+            f"Posterior of {run_dir}; scenario {report['scenario']}; sun at zenith {report['sun']['zenith_deg']:.2f} deg, "
+            f"azimuth {report['sun']['azimuth_deg']:.2f} deg (astropy); reading '{report['reading']}'; {report['draws']} draws.")
+         + H.bullets(assumptions)),
+        ("Table 3 as distributions (median [5 %, 95 %])", H.table(["case"] + [label for _, label, _ in QUANTITIES], rows)
+         + H.paragraph(report["dominance"])
+         + H.image(H.png_file_to_data_uri(out / "contrast_histograms.png"))),
+        ("Radiometry at the detection limit (eqs 35-38, Table 2)", H.table(
+            ["N_s (e-)", "N_B (e-)", "noise (e-)", "SNR", "flux for the required SNR (photons m^-2 s^-1)"],
+            [[f"{rad['N_s']:.1f}", f"{rad['N_B']:.2e}", f"{rad['noise']:.2f}", f"{rad['snr']:.2f}",
+              f"{rad['limit_flux_for_required_snr']:.4g}"]])),
+        ("The paper's Table 3 recomputed from its own inputs", H.table(
+            ["case", "sky DOP", "limiting magnitude", "raw contrast", "polarization contrast", "verdict"], paper)
+         + H.bullets([f"{p['case']} / {k}: {v['why']}" for p in report["paper_table3"] for k, v in p.items() if isinstance(v, dict)])),
+    ]
+    with atomic_path(out / "report.html") as tmp:
+        tmp.write_text(H.page("spacepol contrast: detecting the target against the daytime sky", sections), encoding="utf-8")

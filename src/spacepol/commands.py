@@ -324,40 +324,15 @@ def sky(args) -> int:
 
 
 def contrast(args) -> int:
-    from .detect.contrast import propagate
-    from .detect.paper_table3 import recompute
     from .detect.scenario import default_scenario, read_scenario
-    from .io.run_dir import load_run
-    from .report.contrast_report import table3_lines, write_contrast_report
+    from .report.contrast_report import make_contrast_report, table3_lines
 
     scenario = read_scenario(args.scenario) if args.scenario else default_scenario()
     if args.draws < 100:
         raise ParameterError(f"--draws {args.draws}: need at least 100 for 90 % intervals")
-    spec, samples, summary = load_run(args.run_dir)
-    model = build_model(spec)
-    report = propagate(model, samples, scenario, np.random.default_rng(args.seed), draws=args.draws, reading=args.reading)
-    report["paper_table3"] = recompute(scenario.instrument)
-    report["model"] = spec
-    report["seed"] = args.seed
-    assumptions = contrast_assumptions(summary, scenario)
     out = Path(args.out) if args.out else Path(args.run_dir) / "contrast"
-    write_contrast_report(report, out, str(args.run_dir), assumptions)
+    report = make_contrast_report(args.run_dir, scenario, out, args.reading, args.draws, args.seed)
     print("\n".join(table3_lines(report)))
     print(report["dominance"])
     print(f"wrote {out}/contrast.json, table3.md, contrast_histograms.png, report.html")
     return 0
-
-
-def contrast_assumptions(summary: dict, scenario) -> list[str]:
-    t, sky_ = scenario.target, scenario.sky
-    return [
-        f"Target DOP from the posterior of {summary['model']} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "
-        f"theta_r uniform in [{t['theta_r_low_deg']:g}, {t['theta_r_high_deg']:g}] deg (the paper's Figure 9 range), "
-        "unless a case fixes theta_r_deg.",
-        "The material's posterior is used as measured; no dispersion to the 1.5-1.8 um band is modelled.",
-        f"Sky DOP from the {sky_['model']} model with P_max uniform in [{sky_['p_max_low']:g}, {sky_['p_max_high']:g}] "
-        "(a clear sky peaks near 0.7-0.8), sun from astropy for the scenario's site and time.",
-        f"Limiting magnitude from eq 39 (angstrom, per cm^2) at Phi_s = {scenario.instrument['limit_flux_photons_m2_s']:g} "
-        f"photons m^-2 s^-1; raw contrast against a sky of {scenario.instrument['sky_magnitude']:g} mag (implied by Table 3, "
-        "not stated in the paper).",
-    ]

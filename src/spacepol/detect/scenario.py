@@ -46,7 +46,7 @@ INSTRUMENT = {  # Table 2 and the text around eqs 35-39
 }
 SECTIONS = {"site": SITE, "sky": SKY, "target": TARGET, "instrument": INSTRUMENT}
 CASE_KEYS = {"name": (None, None, "text"), "zenith_deg": ("deg", None, "any"), "azimuth_deg": ("deg", None, "any"),
-             "sky_dop": ("", None, "fraction")}
+             "sky_dop": ("", None, "fraction"), "theta_r_deg": ("deg", None, "any")}
 PAPER_CASES = [  # Table 3: "A" is the zenith angle, "E" the azimuth (row 2's azimuth: 101 deg 28' in the table)
     {"name": "A = 10 deg, E = 101 deg 28'", "zenith_deg": 10.0, "azimuth_deg": 101 + 28 / 60},
     {"name": "A = 60 deg, E = 101 deg 28'", "zenith_deg": 60.0, "azimuth_deg": 101 + 28 / 60},

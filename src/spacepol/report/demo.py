@@ -8,7 +8,8 @@
    (``hidden/``), then the hidden truth revealed.
 4. The same on PTFE (``ptfe_diagnose/``, ``ptfe_ladder/``): which effects improve ELPD-LOO by
    more than 2 SE, and the error falling as they are added.
-5. ``report.html`` links them and says what was found.
+5. The PTFE posterior against the daytime sky: Table 3 as distributions (``contrast/``).
+6. ``report.html`` links them and says what was found.
 """
 
 from __future__ import annotations
@@ -16,8 +17,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
-import json
 
 from ..criticism.diagnose import diagnose
 from ..criticism.ladder import climb
@@ -30,7 +29,12 @@ from ..physics.geometry import Geometry
 from ..physics.model import Model
 from . import html as H
 from .figures import dop_versus_theta_r
+from ..detect.scenario import default_scenario
+from ..io.atomic import save_figure
+from ..sky.rayleigh import RayleighSky
+from .contrast_report import make_contrast_report, table3_lines
 from .diagnose_report import significance_statement, write_diagnose_report
+from .sky_figures import projection_distortion_figure, sky_maps_figure
 from .ladder_report import write_ladder_report
 from .run_report import write_run_report
 
@@ -100,16 +104,33 @@ def _criticism_section(report, rungs, folder: str) -> str:
             + f'<p><a href="{Path(folder).name}/diagnose/report.html">Full diagnosis</a></p>')
 
 
+def hidden_truth(metadata: dict) -> dict:
+    """What synth hid: the effects beyond the paper's model and their values (from the file header)."""
+    model = metadata.get("model", "")
+    base = {"specular", "shadowing", "body"}
+    hidden = [e for e in model.split("+") if e and e not in base]
+    values = {k[6:]: v for k, v in metadata.items() if k.startswith("truth_")}
+    own = {name: values[name] for e in hidden for name in _effect_parameters(e) if name in values}
+    return {"hidden_effect": "+".join(hidden) or "none", "hidden_parameters": own or "(none: a change of shape)",
+            "description": f"{len(hidden)} effect(s), revealed at the end"}
+
+
+def _effect_parameters(name: str) -> list[str]:
+    from ..physics.registry import registry
+
+    return [p.name for p in registry.get(name).parameters]
+
+
 def run_demo(out: Path, seed: int = 0) -> None:
     out.mkdir(parents=True, exist_ok=True)
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
     data = read_measurements(source).at_wavelength(0.633).in_plane()
-    print(f"1/4 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
+    print(f"1/5 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
     forward_lines = forward_comparison(data, out)
     for line in forward_lines:
         print("   " + line)
 
-    print("2/4 inversion of the PTFE measurement (DOP + BRDF) with the paper's model")
+    print("2/5 inversion of the PTFE measurement (DOP + BRDF) with the paper's model")
     posterior = Posterior.build(data, Model.from_string("paper"))
     inv = invert(posterior, seed=seed, backend_path=None, progress=True)
     summary = write_run_report(inv, out / "ptfe_paper", f"{source} (0.633 um, in-plane)", references={"n": PTFE_INDEX})
@@ -119,18 +140,28 @@ def run_demo(out: Path, seed: int = 0) -> None:
           f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}")
 
     hidden_path = bundled("synthetic", "hidden_effect.csv")
-    truth = json.loads(bundled("synthetic", "hidden_effect_truth.json").read_text())
-    print(f"3/4 what is missing? fit -> diagnose -> ladder on {hidden_path.name} (a synthetic set with a hidden effect)")
+    print(f"3/5 what is missing? fit -> diagnose -> ladder on {hidden_path.name} (a synthetic set with a hidden effect)")
     hidden = read_measurements(hidden_path)
+    truth = hidden_truth(hidden.metadata)
     hidden_base = invert(Posterior.build(hidden, Model.from_string("paper")), seed=seed, progress=False)
     hidden_report, hidden_rungs = criticise(hidden, hidden_base, out / "hidden", str(hidden_path), seed)
     found = "found" if hidden_report["verdict"] == truth["hidden_effect"] or truth["hidden_effect"] in \
         hidden_report["ranking"][0].get("tied_with", []) else "NOT found"
     print(f"   verdict {hidden_report['verdict']}; the hidden effect was {truth['hidden_effect']} ({found})")
 
-    print("4/4 what is missing from the paper's model on PTFE? diagnose -> ladder")
+    print("4/5 what is missing from the paper's model on PTFE? diagnose -> ladder")
     ptfe_report, ptfe_rungs = criticise(data, inv, out / "ptfe", f"{source} (0.633 um, in-plane)", seed)
     print("   " + significance_statement(ptfe_report))
+
+    print("5/5 detecting a target of this material against the daytime sky: the paper's Table 3 as distributions")
+    scenario = default_scenario()
+    contrast = make_contrast_report(out / "ptfe_paper", scenario, out / "contrast", "corrected", seed=seed)
+    for line in table3_lines(contrast):
+        print("   " + line)
+    sun = (contrast["sun"]["zenith_deg"], contrast["sun"]["azimuth_deg"])
+    targets = {f"target {i + 1}": (c["zenith_deg"], c["azimuth_deg"]) for i, c in enumerate(scenario.cases)}
+    save_figure(sky_maps_figure(RayleighSky(0.8), sun, targets), out / "contrast" / "sky_maps.png")
+    save_figure(projection_distortion_figure(), out / "contrast" / "projections.png")
 
     sections = [
         ("What this is", H.paragraph(
@@ -155,6 +186,19 @@ def run_demo(out: Path, seed: int = 0) -> None:
          + _criticism_section(hidden_report, hidden_rungs, out / "hidden")
          + H.paragraph(f"Revealed: the hidden effect was {truth['hidden_effect']} with {truth['hidden_parameters']} ({found}).")),
         ("4. What the paper's model misses on PTFE", _criticism_section(ptfe_report, ptfe_rungs, out / "ptfe")),
+        ("5. Against the daytime sky: Table 3 as distributions", H.paragraph(
+            f"The PTFE posterior (paper's model) at the paper's geometry (theta_i 30 deg, dphi 180 deg, theta_r 0-80 deg), "
+            f"the sky of the paper's site and time (sun from astropy: zenith {sun[0]:.2f} deg, azimuth {sun[1]:.2f} deg; "
+            f"the paper's 29 deg 30' / -4 deg 32' is wrong for that date), Rayleigh with P_max in "
+            f"[{scenario.sky['p_max_low']:g}, {scenario.sky['p_max_high']:g}], Table 2's instrument, micro-polarizer superpixels.")
+         + H.table(["case", "target DOP", "sky DOP", "limiting magnitude", "raw contrast", "polarization contrast"],
+                   [[r["case"]] + [f"{r[k]['median']:.4g} [{r[k]['q05']:.4g}, {r[k]['q95']:.4g}]" for k in
+                                   ("target_dop", "sky_dop", "limiting_magnitude", "intensity_contrast", "polarization_contrast")]
+                    for r in contrast["rows"]])
+         + H.paragraph(contrast["dominance"])
+         + H.image(H.png_file_to_data_uri(out / "contrast" / "sky_maps.png"), "Sky DOP and AoP in the three projections, the two target directions in red.")
+         + H.image(H.png_file_to_data_uri(out / "contrast" / "projections.png"), "What each projection does to shapes and areas.")
+         + '<p><a href="contrast/report.html">Full contrast report (radiometry, the paper\'s Table 3 recomputed)</a></p>'),
     ]
     (out / "report.html").write_text(H.page("spacepol demo: PTFE", sections), encoding="utf-8")
-    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/)")
+    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/, contrast/)")

@@ -52,22 +52,6 @@ def test_diagnose_rejects_unknown_candidates(tmp_path):
     assert "unknown effect 'sparkle'" in run.stderr and not (tmp_path / "d.json").exists()
 
 
-def test_ladder_shows_the_error_falling(tmp_path):
-    data = _hidden_polarized_diffuse(tmp_path)
-    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "ladder", data, "--model", "paper", "--add",
-                          "polarized_diffuse", "--json", tmp_path / "ladder.json", "--out", tmp_path / "lad"],
-                         capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr
-    rungs = json.loads((tmp_path / "ladder.json").read_text())["rungs"]
-    assert [r["model"] for r in rungs] == ["specular+shadowing+body", "specular+shadowing+body+polarized_diffuse"]
-    for r in rungs:
-        assert set(r) >= {"model", "rmse_dop", "chi2_red", "elpd_loo"}
-    assert rungs[1]["rmse_dop"] < 0.2 * rungs[0]["rmse_dop"]
-    assert rungs[0]["chi2_red"] > 10 and abs(rungs[1]["chi2_red"] - 1) < 1.5  # down to the noise floor
-    assert rungs[1]["elpd_loo"] > rungs[0]["elpd_loo"]
-    assert (tmp_path / "lad" / "ladder.png").stat().st_size > 0 and "| 1 |" in (tmp_path / "lad" / "ladder.md").read_text()
-
-
 def _case_report(case, candidates=None, top=3):
     from spacepol.criticism.diagnose import diagnose
     from spacepol.criticism.hidden_effects import BASE, measurement

@@ -28,6 +28,9 @@ def test_tutorial_finds_and_closes_a_user_effect(tmp_path):
         assert (tmp_path / "diagnose" / name).stat().st_size > 0
 
     rungs = json.loads((tmp_path / "ladder.json").read_text())["rungs"]
+    assert [r["model"] for r in rungs] == ["specular+shadowing+body", "specular+shadowing+body+sheen"]
+    assert all(set(r) >= {"model", "rmse_dop", "chi2_red", "elpd_loo"} for r in rungs)
+    assert (tmp_path / "ladder" / "ladder.png").stat().st_size > 0 and "| 1 |" in (tmp_path / "ladder" / "ladder.md").read_text()
     assert rungs[0]["chi2_red"] > 10 and abs(rungs[1]["chi2_red"] - 1) < 1.5
     assert rungs[1]["rmse_dop"] < 0.3 * rungs[0]["rmse_dop"] and rungs[1]["elpd_loo"] > rungs[0]["elpd_loo"]
     # the hidden value (the file's metadata records it) is recovered inside the 90 % interval

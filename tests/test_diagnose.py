@@ -1,10 +1,11 @@
-"""`diagnose` (issue 4, first version): a hidden effect is named; DESIGN's JSON fields."""
+"""`diagnose` (issue 4): a hidden effect is named; DESIGN's JSON fields; nulls, twins, priors, PTFE."""
 
 import json
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from spacepol.io.measurements import write_table
 
@@ -117,3 +118,23 @@ def test_prior_overrides_reach_the_models_that_have_the_parameter():
         assert "sparkle" in str(exc)
     else:
         raise AssertionError("an unknown prior name was accepted")
+
+
+@pytest.mark.slow
+def test_ptfe_diagnosis_states_which_effects_improve_elpd(tmp_path):
+    """On the bundled PTFE measurement (0.633 um, in-plane, DOP + BRDF) diagnose runs with the whole library
+    and its report says which effects improve ELPD-LOO by more than 2 SE and which do not."""
+    from spacepol.paths import bundled
+
+    out, js = tmp_path / "ptfe", tmp_path / "ptfe.json"
+    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
+                          "--wavelength-um", "0.633", "--in-plane", "--json", js, "--out", out], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads(js.read_text())
+    confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]
+    assert len(confirmed) >= 3 and len(report["ranking"]) >= 8
+    html = (out / "report.html").read_text()
+    assert "Improve ELPD-LOO by more than 2 SE:" in html and "Do not:" in html
+    for r in confirmed:  # every refitted effect appears in the statement, on the side its flag says
+        assert r["effect"] in html.split("Improve ELPD-LOO by more than 2 SE:")[1]
+        assert r["significant"] == (r["delta_elpd"] > 2 * r["delta_elpd_se"] and r["delta_elpd"] > 4)

@@ -32,7 +32,7 @@ def run_out(tmp_path_factory):
 
 def test_run_writes_the_design_outputs(run_out):
     out = run_out
-    for name in ("summary.json", "posterior.nc", "corner.png", "fit.png", "residuals.png", "report.html"):
+    for name in ("summary.json", "posterior.nc", "corner.png", "fit.png", "residuals.png", "residual_trends.png", "report.html"):
         assert (out / name).stat().st_size > 0, name
     s = json.loads((out / "summary.json").read_text())
     assert s["model"] == "specular+smith"

@@ -183,7 +183,7 @@ def run(args) -> int:
                  backend_path=out / "chain.h5", progress=not args.quiet)
     summary = write_run_report(inv, out, args.data, references=references)
     d = summary["diagnostics"]
-    print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, report.html "
+    print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, residual_trends.png, report.html "
           f"(R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")
     return 0
 

@@ -56,7 +56,9 @@ class Likelihood:
                     raise ParameterError(f"{data.source}: {name}_err must be > 0 to weigh the fit (found {err.min():g})")
                 self._errors[name] = err
         self.geometry = data.geometry
-        self.labels = [f"{name}[{i}]" for name in self.observables for i in range(len(data))]
+        # observation names that say where a point is (Pareto-k warnings quote them)
+        self.labels = [f"{name}[{i}] (theta_i {data.theta_i[i]:g}, theta_r {data.theta_r[i]:g}, dphi {data.dphi[i]:g} deg)"
+                       for name in self.observables for i in range(len(data))]
 
     @property
     def n_obs(self) -> int:

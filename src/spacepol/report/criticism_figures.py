@@ -73,3 +73,26 @@ def ladder_figure(rungs, fig=None) -> Figure:
     ax2.set_ylabel("ELPD-LOO", color="C1")
     ax.set_title("each rung adds one effect: the error falls towards the noise floor (chi^2 = 1)", fontsize=9)
     return fig
+
+
+def residual_trends_figure(structure, fig=None) -> Figure:
+    """Standardised residuals against theta_i, theta_r, dphi, phase angle and the DOP level (one row per
+    observable), each panel with its Spearman rank correlation; a red title marks p < 0.01."""
+    variables = [v for v in ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level") if v in structure.trends[structure.observables[0]]]
+    fig = fig or Figure(figsize=(2.6 * len(variables) + 0.5, 2.4 * len(structure.observables)), layout="constrained")
+    axes = fig.subplots(len(structure.observables), len(variables), squeeze=False, sharey="row")
+    for i, o in enumerate(structure.observables):
+        z = structure.residuals[o]
+        for j, var in enumerate(variables):
+            ax = axes[i, j]
+            ax.scatter(structure.variables[var], z, s=6, alpha=0.7)
+            ax.axhline(0, color="k", lw=0.6)
+            for level in (-2, 2):
+                ax.axhline(level, color="k", lw=0.4, ls=":")
+            t = structure.trends[o][var]
+            ax.set_title(f"rho {t['rho']:+.2f}, p {t['p']:.1g}", fontsize=7, color="C3" if t["p"] < 0.01 else "k")
+            ax.set_xlabel(var.replace("_deg", " (deg)").replace("_", " "), fontsize=8)
+            if j == 0:
+                ax.set_ylabel(f"{o} residual / noise", fontsize=8)
+    fig.suptitle("Residual trends: a physical effect shows as a trend, noise does not", fontsize=9)
+    return fig

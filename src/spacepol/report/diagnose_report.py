@@ -6,8 +6,18 @@ from pathlib import Path
 
 from ..io.atomic import atomic_path, save_figure
 from . import html as H
-from .criticism_figures import signature_figure
+from ..criticism.residuals import analyse
+from .criticism_figures import residual_trends_figure, signature_figure
 from .inversion_figures import residual_figure
+
+
+def pareto_warnings(summary: dict) -> list[str]:
+    bad = summary.get("pareto_k_bad", [])
+    if not bad:
+        return []
+    return [f"PSIS-LOO is unreliable (Pareto k > 0.7) at {len(bad)} point(s), where the fit hinges on single "
+            f"observations: {', '.join(bad[:10])}{' ...' if len(bad) > 10 else ''}. Their ELPD terms, and deltas "
+            "that rest on them, carry more error than the SE says."]
 
 
 def ranking_rows(report: dict) -> list[list]:
@@ -40,6 +50,8 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     out.mkdir(parents=True, exist_ok=True)
     paths = {"base": out / "residuals_base.png", "signatures": out / "signatures.png"}
     save_figure(residual_figure(base.posterior, base.result), paths["base"])
+    paths["trends"] = out / "residual_trends_base.png"
+    save_figure(residual_trends_figure(analyse(base.posterior, base.result.flat_samples())), paths["trends"])
     for c in confirmed:
         paths[c["effect"]] = out / f"residuals_{c['effect']}.png"
         save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["effect"]])
@@ -49,7 +61,7 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
         ("Data and base model", H.paragraph(
             f"{data_label}; base model {report['model']}: RMSE(DOP) {fit['rmse_dop'] if fit['rmse_dop'] is None else round(fit['rmse_dop'], 5)}, "
             f"reduced chi^2 {fit['chi2_red']:.2f}, ELPD-LOO {fit['elpd_loo']:.1f} +- {fit['elpd_loo_se']:.1f}.")
-         + H.bullets(report["residual_structure"])),
+         + H.bullets(report["residual_structure"] + pareto_warnings(base.summary))),
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
         ("Ranking", H.table(["effect", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
                              "significant (> 2 SE and > 4)"], ranking_rows(report))
@@ -57,7 +69,8 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
         ("Signatures", H.image(H.png_file_to_data_uri(paths["signatures"]),
                                "Dots: residuals of the base fit / noise. Crosses: what each candidate changes in the "
                                "prediction, in the same units. A candidate that explains the misfit follows the dots.")),
-        ("Residuals of the base fit", H.image(H.png_file_to_data_uri(paths["base"]))),
+        ("Residuals of the base fit", H.image(H.png_file_to_data_uri(paths["base"]))
+         + H.image(H.png_file_to_data_uri(paths["trends"]), "The structure: residuals against each variable.")),
     ]
     with atomic_path(out / "report.html") as tmp:
         tmp.write_text(H.page(f"spacepol diagnose: what is missing from {report['model']}", sections), encoding="utf-8")

@@ -1,4 +1,5 @@
-"""Files of ``invert-mcmc run``: summary.json, posterior.nc, corner.png, fit.png, residuals.png, report.html."""
+"""Files of ``invert-mcmc run``: summary.json, posterior.nc, corner.png, fit.png, residuals.png,
+residual_trends.png, report.html."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ import numpy as np
 
 from ..io.atomic import atomic_path, save_figure, write_json
 from . import html as H
+from ..criticism.residuals import analyse
+from .criticism_figures import residual_trends_figure
 from .inversion_figures import corner_figure, fit_figure, residual_figure
 
 
@@ -55,6 +58,7 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
         "corner.png": corner_figure(result, truths),
         "fit.png": fit_figure(posterior, result, posterior.likelihood.observables[0]),
         "residuals.png": residual_figure(posterior, result),
+        "residual_trends.png": residual_trends_figure(analyse(posterior, result.flat_samples())),
     }
     for name, fig in figures.items():
         save_figure(fig, out / name)
@@ -95,7 +99,9 @@ def _html(inv, data_path, figures, truths, notes) -> str:
                         + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
          + H.bullets(s["residual_structure"]["findings"])
          + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction.")
-         + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")),
+         + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")
+         + H.image(H.figure_to_data_uri(figures["residual_trends.png"]),
+                   "Residuals against each angle and the DOP level, with Spearman's rho (red: p < 0.01).")),
         ("Posterior", H.image(H.figure_to_data_uri(figures["corner.png"]), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),
     ]
     if notes:

@@ -32,7 +32,9 @@ SEPARATING_MEASUREMENT = {
 
 
 def _first_sentence(text: str) -> str:
-    return text.split(". ")[0].rstrip(".") + "."
+    import re
+
+    return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."
 
 
 def _candidates(model: Model, data, names=None):
@@ -235,10 +237,11 @@ def _conclusion(base, confirmed, verdict) -> str:
 
 
 def _tied(a, b) -> bool:
-    """Equal predictive performance within noise: |delta ELPD| < 2 SE of the difference, or < 4
-    (below 4 the difference is not worth a standard error; Sivula, Magnusson & Vehtari 2020)."""
+    """Equal predictive performance within noise: |delta ELPD| below 1 SE of the difference, or below 4
+    (exact twins differ by sampling noise only, whose sum is small in absolute terms but not in SE
+    units; Sivula, Magnusson & Vehtari 2020)."""
     diff = a["pointwise"] - b["pointwise"]
-    return abs(diff.sum()) < max(2 * np.sqrt(len(diff) * np.var(diff)), 4.0)
+    return abs(diff.sum()) < max(np.sqrt(len(diff) * np.var(diff)), MIN_DELTA_ELPD)
 
 
 def _explain(c, base) -> str:
@@ -250,7 +253,9 @@ def _explain(c, base) -> str:
     why = []
     data = base.posterior.likelihood.data
     for o, s in signatures(base, c["inversion"]).items():
+        change = (f"removes {100 * s['chi2_removed']:.0f} % of their chi^2" if s["chi2_removed"] >= 0
+                  else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
-                   f"correlates {s['correlation']:+.2f} with the residuals and removes {100 * s['chi2_removed']:.0f} % of their chi^2")
+                   f"correlates {s['correlation']:+.2f} with the residuals and {change}")
     return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
             f"{change}" + "; ".join(why) + ".")

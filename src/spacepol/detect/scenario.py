@@ -8,11 +8,11 @@ The defaults are the paper's (section 4 and Table 2); ``default_scenario()`` ret
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import SpacepolError
+from ..io.toml_file import read_toml
 
 # key: (astropy unit or "" for dimensionless, default, check) ; check in {"positive", "fraction", "any", "nonnegative"}
 SITE = {"lat_deg": ("deg", 43 + 8 / 60, "any"), "lon_deg": ("deg", 125 + 32 / 60, "any"),
@@ -111,12 +111,7 @@ def default_scenario() -> Scenario:
 
 def read_scenario(path) -> Scenario:
     path = Path(path)
-    if not path.is_file():
-        raise SpacepolError(f"{path}: scenario file not found")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SpacepolError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path, "scenario")
     unknown = sorted(set(data) - set(SECTIONS) - {"cases"})
     if unknown:
         raise SpacepolError(f"{path}: unknown section(s) {', '.join(unknown)} (known: {', '.join(SECTIONS)}, cases)")

@@ -22,12 +22,12 @@ GA, nlopt and differential evolution search the very space the sampler sees.
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError, SpacepolError
+from ..errors import ParameterError
+from ..io.toml_file import read_toml
 from ..physics.parameter import Parameter
 from .priors import Fixed, LogUniform, Prior, TruncatedNormal, Uniform
 
@@ -68,12 +68,7 @@ def _float(value, name, key, where):
 
 def read_prior_file(path) -> dict[str, Prior]:
     path = Path(path)
-    if not path.is_file():
-        raise SpacepolError(f"{path}: prior file not found")
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise SpacepolError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path, "prior")
     priors = {}
     for name, table in data.items():
         if not isinstance(table, dict):

@@ -33,9 +33,12 @@ def test_tutorial_finds_and_closes_a_user_effect(tmp_path):
     assert (tmp_path / "ladder" / "ladder.png").stat().st_size > 0 and "| 1 |" in (tmp_path / "ladder" / "ladder.md").read_text()
     assert rungs[0]["chi2_red"] > 10 and abs(rungs[1]["chi2_red"] - 1) < 1.5
     assert rungs[1]["rmse_dop"] < 0.3 * rungs[0]["rmse_dop"] and rungs[1]["elpd_loo"] > rungs[0]["elpd_loo"]
-    # the hidden value (the file's metadata records it) is recovered inside the 90 % interval
+    # the hidden value (the file's metadata records it) is recovered: within 3.3 posterior standard
+    # deviations (a 0.1 % chance to fail for a calibrated posterior; one 90 % interval alone misses 1 time in 10,
+    # and the suite in test_hidden_effects checks 90 % coverage over many cases)
     from spacepol.io import read_measurements
 
     truth = float(read_measurements(tmp_path / "sheen_hidden.csv").metadata["truth_b_sheen"])
     b = rungs[1]["parameters"]["b_sheen"]
-    assert b["q05"] <= truth <= b["q95"], (truth, b)
+    sd = (b["q84"] - b["q16"]) / 2
+    assert abs(b["median"] - truth) < 3.3 * sd, (truth, b)

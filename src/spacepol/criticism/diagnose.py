@@ -74,7 +74,11 @@ def _screen(posterior, rng, budget, seeds=None):
     return value, dict(zip(posterior.priors.names, theta))
 
 
-def _nested_seeds(base_best: dict, candidate, posterior) -> np.ndarray:
+def _vector(values: dict, posterior) -> np.ndarray:
+    return np.array([values[n] for n in posterior.priors.names], float)
+
+
+def nested_seeds(base_best: dict, candidate, posterior) -> np.ndarray:
     """Start points of M + E at M's optimum: E's own parameters at their prior's lower end, default,
     upper end and middle (most effects vanish at one of them: rho_pd = 0, e = 1, delta = 0, ...);
     a parameter that splits one of M's (sigma -> sigma_x, sigma_y) starts at its value."""
@@ -102,20 +106,21 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
+    base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
     if base is None:
         if progress:
             print(f"  fitting {model.name} ...", flush=True)
-        base = invert(base_post, seed=seed, max_steps=max_steps, progress=False)
+        base = invert(base_post, seed=seed, max_steps=max_steps, progress=False, centre=_vector(base_optimum, base_post))
     base_loo = base.loo["pointwise"]
     clock["base"] = time.perf_counter()
-    base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
 
     screened = []
     for name, candidate in _candidates(model, data, candidates):
         post = _build(data, candidate, observables, priors)
-        best, _ = _screen(post, rng, screening_evaluations, seeds=_nested_seeds(base_optimum, candidate, post))
+        best, optimum = _screen(post, rng, screening_evaluations, seeds=nested_seeds(base_optimum, candidate, post))
         gain = best - base_best
-        screened.append({"effect": name, "model": candidate, "posterior": post, "screening_gain": float(gain)})
+        screened.append({"effect": name, "model": candidate, "posterior": post, "screening_gain": float(gain),
+                         "optimum": _vector(optimum, post)})
         if progress:
             print(f"  screening {name:<18s} max log posterior gain {gain:9.2f}", flush=True)
     screened.sort(key=lambda c: -c["screening_gain"])
@@ -127,7 +132,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     for c in to_confirm:
         if progress:
             print(f"  confirming {c['effect']} with emcee ...", flush=True)
-        inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False)
+        # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
+        inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False, centre=c["optimum"])
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..infer.inversion import invert
+from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
+from .diagnose import nested_seeds
 
 
 def climb(data, model: Model, additions: list[str], seed: int = 0, observables=None, max_steps: int = 8000,
@@ -19,7 +23,11 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
             if progress:
                 print(f"  fitting {current.name} ...", flush=True)
             post = Posterior.build(data, current, observables=observables)
-            inv = invert(post, seed=seed, max_steps=max_steps, progress=False)
+            centre = None
+            if rungs:  # start from the previous rung's optimum, the new effect at its neutral values
+                seeds = nested_seeds(rungs[-1]["_inversion"].summary["map"], current, post)
+                centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
+            inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
         fit = inv.summary["fit"]
         rungs.append({"model": current.name, "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from .diagnostics import convergence, fit_statistics, loo, quantiles
-from .engines.emcee_sampler import default_walkers, sample_emcee
+from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
 from .inference_data import to_inference_data
 from .posterior import Posterior
@@ -58,7 +58,9 @@ def _stamp_backend(path: Path, print_: str) -> None:
 
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
-           backend_path=None, progress: bool = True, check_every: int = 500) -> Inversion:
+           backend_path=None, progress: bool = True, check_every: int = 500, centre=None) -> Inversion:
+    """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
+    around which the walkers start; by default a global optimisation finds one."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = walkers or default_walkers(posterior.ndim)
@@ -71,7 +73,8 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         _stamp_backend(backend_path, print_)  # before sampling, so an interrupted chain is recognised
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
-                          check_every=check_every)
+                          check_every=check_every,
+                          initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
     idata = to_inference_data(result, posterior, rng)
     loo_result = loo(idata)
     summary = {

@@ -1,10 +1,13 @@
 """The maximum of the log posterior, found globally: where emcee starts and what screening compares.
 
-Differential evolution searches the prior cube. One region of the index plane needs help: the
-dielectric branch k ~ 0 (PTFE, paints, glass) is a sliver of the cube under the default prior
-k ~ U(0, 20) (k < 0.05 is 0.25 % of it), and DE started from random points converges on an
-absorbing optimum before it looks there. So when k is free, a second DE runs with k pinned at 0
-and the better optimum, judged by the full posterior, wins.
+Three searches, the best (by the full posterior) wins:
+* differential evolution on the prior cube;
+* the dielectric branch: k ~ 0 (PTFE, paints, glass) is a sliver of the cube under the default
+  prior k ~ U(0, 20) (k < 0.05 is 0.25 % of it) and DE converges on an absorbing optimum before
+  it looks there, so when k is free a second DE runs with k pinned at 0;
+* a multistart: 8192 scrambled Sobol points, the best 8 polished by L-BFGS-B. Thin films make the
+  posterior a comb of interference orders in which DE settles on a wrong tooth (a film hidden
+  at 0.25 um: DE -443, multistart +845 in log posterior, the truth +841).
 """
 
 from __future__ import annotations
@@ -41,4 +44,29 @@ def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: in
         value = float(posterior.log_prob(theta[None, :])[0])
         if value > best_value:
             best_value, best = value, theta
+    value, theta = multistart(posterior, rng)
+    if value > best_value:
+        best_value, best = value, theta
     return best_value, best
+
+
+def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 8192, polish: int = 8) -> tuple[float, np.ndarray]:
+    """Best of ``polish`` L-BFGS-B runs started at the best of ``points`` Sobol points in the prior cube."""
+    from scipy.optimize import minimize
+    from scipy.stats import qmc
+
+    objective, priors = NegativeLogPosterior(posterior), posterior.priors
+
+    def f(u):
+        return objective(priors.rescale(np.clip(u, 0.0, 1.0)))
+
+    u = qmc.Sobol(priors.ndim, rng=np.random.default_rng(rng.integers(2**63))).random(points)
+    values = np.concatenate([f(u[i : i + 4096]) for i in range(0, points, 4096)])
+    starts = u[np.argsort(values)[:polish]]
+    best_value, best_u = np.inf, starts[0]
+    for start in starts:
+        res = minimize(lambda x: float(f(x[None, :])[0]), start, method="L-BFGS-B", bounds=[(0.0, 1.0)] * priors.ndim)
+        if res.fun < best_value:
+            best_value, best_u = float(res.fun), np.clip(res.x, 0.0, 1.0)
+    theta = priors.rescale(best_u[None, :])[0]
+    return float(posterior.log_prob(theta[None, :])[0]), theta

@@ -46,18 +46,24 @@ def default_walkers(ndim: int) -> int:
 
 
 def initial_ball(posterior, rng, walkers, init_evaluations=3000):
-    """Walkers around the global optimum (``infer.optimum``); each inside the prior with finite log posterior."""
+    """Walkers around the global optimum (``infer.optimum``)."""
     from ..optimum import find_optimum
 
     _, centre = find_optimum(posterior, rng, evaluations=init_evaluations)
+    return ball(posterior, centre, walkers, rng)
+
+
+def ball(posterior, centre, walkers, rng):
+    """Walkers in a tight ball (1e-3 of each prior width) around ``centre``, each inside the prior
+    with a finite log posterior (else at the centre itself)."""
     width = np.diff(posterior.priors.bounds, axis=1).ravel()
     width = np.where(np.isfinite(width), width, 1.0)
-    ball = centre + 1e-3 * width * rng.standard_normal((walkers, posterior.ndim))
+    ball_ = centre + 1e-3 * width * rng.standard_normal((walkers, posterior.ndim))
     lo, hi = posterior.priors.bounds.T
-    ball = np.clip(ball, lo + 1e-9 * width, hi - 1e-9 * width)
-    bad = ~np.isfinite(posterior.log_prob(ball))
-    ball[bad] = centre
-    return ball
+    ball_ = np.clip(ball_, lo + 1e-9 * width, hi - 1e-9 * width)
+    bad = ~np.isfinite(posterior.log_prob(ball_))
+    ball_[bad] = centre
+    return ball_
 
 
 def _kept(sampler, tau):

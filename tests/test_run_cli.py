@@ -5,7 +5,6 @@ import subprocess
 import sys
 
 import arviz as az
-import numpy as np
 import pytest
 
 from spacepol.paths import bundled

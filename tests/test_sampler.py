@@ -8,7 +8,7 @@ from spacepol.infer.posterior import Posterior
 from spacepol.infer.prior_set import PriorSet
 from spacepol.infer.priors import Fixed, Uniform
 from spacepol.io.measurements import Dataset
-from spacepol.physics import Geometry, Model
+from spacepol.physics import Model
 
 
 def synthetic(model_spec, truth, n_theta_i=(20, 40, 60), n_r=8, dop_err=0.01, brdf_rel=0.05, seed=0, clip=False):

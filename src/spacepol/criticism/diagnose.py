@@ -17,7 +17,6 @@ import time
 import numpy as np
 
 from ..errors import SpacepolError
-from ..infer.diagnostics import loo
 from ..infer.inference_data import median_fit, standardise
 from ..infer.inversion import invert
 from ..infer.optimum import find_optimum

@@ -7,7 +7,6 @@ A run "succeeds" when its objective is within ``rtol`` of the best objective any
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np

@@ -7,11 +7,7 @@ from matplotlib.figure import Figure
 
 from ..criticism.diagnose import signatures
 from ..infer.inference_data import standardised_residuals
-
-
-def _signed_theta_r(data):
-    """theta_r with a sign: + on the specular side (|dphi| > 90 deg), - on the source side."""
-    return np.where(np.cos(np.radians(data.dphi)) < 0, data.theta_r, -data.theta_r)
+from .inversion_figures import signed_theta_r
 
 
 def signature_figure(base, candidates, fig=None) -> Figure:
@@ -23,7 +19,7 @@ def signature_figure(base, candidates, fig=None) -> Figure:
     crosses follow the dots, the effect explains the misfit.
     """
     data, observables = base.posterior.likelihood.data, base.posterior.likelihood.observables
-    x = _signed_theta_r(data)
+    x = signed_theta_r(data)
     fig = fig or Figure(figsize=(3.3 * max(len(candidates), 1) + 0.8, 2.8 * len(observables)), layout="constrained")
     axes = fig.subplots(len(observables), max(len(candidates), 1), squeeze=False, sharex=True)
     for j, (name, inv) in enumerate(candidates):
@@ -53,7 +49,7 @@ def ladder_figure(rungs, fig=None) -> Figure:
         obs = inv.posterior.likelihood.observables[0]
         z = standardised_residuals(inv.posterior, inv.result.flat_samples())[obs]
         data = inv.posterior.likelihood.data
-        ax.scatter(_signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
+        ax.scatter(signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
         ax.axhline(0, color="k", lw=0.8)
         for level in (-2, 2):
             ax.axhline(level, color="k", lw=0.5, ls=":")

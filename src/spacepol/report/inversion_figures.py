@@ -26,7 +26,8 @@ def _panels(data):
     return [(ti, np.flatnonzero(keys == ti)) for ti in np.unique(keys)]
 
 
-def _signed_theta_r(data, idx):
+def signed_theta_r(data, idx=slice(None)):
+    """theta_r with a sign: + on the specular side (|dphi| > 90 deg), - on the source side."""
     forward = np.cos(np.radians(data.dphi[idx])) < 0
     return np.where(forward, data.theta_r[idx], -data.theta_r[idx])
 
@@ -48,7 +49,7 @@ def fit_figure(posterior, result, observable: str = "dop", max_draws: int = 2000
     y = getattr(data, observable)
     err = getattr(data, f"{observable}_err")
     for ax, (ti, idx) in zip(axes, panels):
-        x = _signed_theta_r(data, idx)
+        x = signed_theta_r(data, idx)
         order = np.argsort(x)
         ax.fill_between(x[order], lo[idx][order], hi[idx][order], color="C0", alpha=0.3, lw=0, label="90 % band")
         ax.plot(x[order], med[idx][order], "-", color="C0", lw=1.2, label="posterior median")
@@ -75,7 +76,7 @@ def residual_figure(posterior, result, fig=None) -> Figure:
     for ax, o in zip(axes, observables):
         z = residuals[o]
         for i, (ti, idx) in enumerate(_panels(data)):
-            ax.plot(_signed_theta_r(data, idx), z[idx], "o", ms=3, color=f"C{i % 10}", label=f"theta_i = {ti:g}")
+            ax.plot(signed_theta_r(data, idx), z[idx], "o", ms=3, color=f"C{i % 10}", label=f"theta_i = {ti:g}")
         ax.axhline(0, color="k", lw=0.8)
         for level in (-2, 2):
             ax.axhline(level, color="k", lw=0.5, ls=":")

@@ -7,7 +7,7 @@ import time
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from ..result import History
+from ..result import History, Result
 
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..result import History
+from ..result import History, Result
 
 
 def _decode(chromosomes, bits):

@@ -8,7 +8,7 @@ import nlopt
 import numpy as np
 
 from ...errors import UnknownNameError
-from ..result import History
+from ..result import History, Result
 
 NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
 

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import re
 import time
 
 import numpy as np
@@ -31,8 +32,6 @@ SEPARATING_MEASUREMENT = {
 
 
 def _first_sentence(text: str) -> str:
-    import re
-
     return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."
 
 
@@ -111,6 +110,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             print(f"  fitting {model.name} ...", flush=True)
         base = invert(base_post, seed=seed, max_steps=max_steps, progress=False, centre=_vector(base_optimum, base_post))
     base_loo = base.loo["pointwise"]
+    base_fit = median_fit(base.posterior, base.result.flat_samples())
     clock["base"] = time.perf_counter()
 
     screened = []
@@ -136,7 +136,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
-                 rmse_dop_after=inv.summary["fit"]["rmse_dop"])
+                 rmse_dop_after=inv.summary["fit"]["rmse_dop"], signatures=signatures(base, inv, base_fit))
         c["significant"] = significant(c["delta_elpd"], c["delta_elpd_se"])
         confirmed.append(c)
     confirmed.sort(key=lambda c: -c["delta_elpd"])
@@ -173,12 +173,12 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             "_base": base, "_confirmed": confirmed}
 
 
-def signatures(base, inv) -> dict:
+def signatures(base, inv, base_fit=None) -> dict:
     """Per observable: the base fit's standardised residuals, and what the candidate changes in the
     prediction in the same noise units (its signature), their correlation and the share of the
-    base chi^2 the candidate removes."""
+    base chi^2 the candidate removes. ``base_fit``: the base's ``median_fit``, if already computed."""
     data = base.posterior.likelihood.data
-    mu0, scale = median_fit(base.posterior, base.result.flat_samples())
+    mu0, scale = base_fit or median_fit(base.posterior, base.result.flat_samples())
     mu1, _ = median_fit(inv.posterior, inv.result.flat_samples())
     out = {}
     for o in base.posterior.likelihood.observables:
@@ -257,7 +257,7 @@ def _explain(c, base) -> str:
     verdict = "significant" if c["significant"] else "not significant (gain within 2 SE or below 4)"
     why = []
     data = base.posterior.likelihood.data
-    for o, s in signatures(base, c["inversion"]).items():
+    for o, s in c["signatures"].items():
         change = (f"removes {100 * s['chi2_removed']:.0f} % of their chi^2" if s["chi2_removed"] >= 0
                   else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..criticism.diagnose import signatures
 from ..infer.inference_data import standardised_residuals
 from .inversion_figures import signed_theta_r
 
@@ -13,8 +12,8 @@ from .inversion_figures import signed_theta_r
 def signature_figure(base, candidates, fig=None) -> Figure:
     """Observed residuals of the base fit (dots) against each candidate's signature (crosses).
 
-    ``base`` is the base model's Inversion, ``candidates`` a list of (effect name, Inversion of
-    base + effect). The signature of a candidate is what it changes in the prediction, in noise
+    ``base`` is the base model's Inversion, ``candidates`` a list of (effect name, its
+    ``criticism.diagnose.signatures``). The signature of a candidate is what it changes in the prediction, in noise
     units: (posterior-median prediction of M + E) - (that of M), divided by the noise. Where the
     crosses follow the dots, the effect explains the misfit.
     """
@@ -22,8 +21,7 @@ def signature_figure(base, candidates, fig=None) -> Figure:
     x = signed_theta_r(data)
     fig = fig or Figure(figsize=(3.3 * max(len(candidates), 1) + 0.8, 2.8 * len(observables)), layout="constrained")
     axes = fig.subplots(len(observables), max(len(candidates), 1), squeeze=False, sharex=True)
-    for j, (name, inv) in enumerate(candidates):
-        sig = signatures(base, inv)
+    for j, (name, sig) in enumerate(candidates):
         for i, o in enumerate(observables):
             ax = axes[i, j]
             ax.scatter(x, sig[o]["observed"], s=9, c=data.theta_i, cmap="viridis", label="observed residual")

@@ -55,7 +55,7 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     for c in confirmed:
         paths[c["effect"]] = out / f"residuals_{c['effect']}.png"
         save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["effect"]])
-    save_figure(signature_figure(base, [(c["effect"], c["inversion"]) for c in confirmed]), paths["signatures"])
+    save_figure(signature_figure(base, [(c["effect"], c["signatures"]) for c in confirmed]), paths["signatures"])
     fit = report["fit"]
     sections = [
         ("Data and base model", H.paragraph(

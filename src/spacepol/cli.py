@@ -3,7 +3,39 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+
+
+def _int_at_least(low: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{value}: must be >= {low}")
+        return value
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
+def _finite(low: float | None = None, strict: bool = False):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"'{text}' is not a finite number")
+        if low is not None and (value <= low if strict else value < low):
+            raise argparse.ArgumentTypeError(f"{value:g}: must be {'>' if strict else '>='} {low:g}")
+        return value
+    parse.__name__ = "number"
+    return parse
+
+
+SEED = _int_at_least(0)  # numpy's Generator takes seeds >= 0
 
 
 class _Parser(argparse.ArgumentParser):
@@ -30,11 +62,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--model", default="paper")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
     p.add_argument("--geometry", help="CSV with theta_i, theta_r[, dphi]; default: 4 x 21 in-plane grid")
-    p.add_argument("--noise-dop", type=float, default=0.0, metavar="X", help="Gaussian DOP noise (absolute)")
-    p.add_argument("--noise-brdf", type=float, default=None, metavar="REL",
+    p.add_argument("--noise-dop", type=_finite(0.0), default=0.0, metavar="X", help="Gaussian DOP noise (absolute)")
+    p.add_argument("--noise-brdf", type=_finite(0.0), default=None, metavar="REL",
                    help="also write BRDF with this relative Gaussian noise")
-    p.add_argument("--wavelength-um", type=float, default=None)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--wavelength-um", type=_finite(0.0, strict=True), default=None)
+    p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", required=True)
 
     sub.add_parser("effects", help="list every registered effect: parameters, priors, units, physics")
@@ -43,15 +75,17 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("data", help="measurement file (spacepol CSV or NIST Mueller BRDF)")
         p.add_argument("--model", default="paper")
         p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
-        p.add_argument("--wavelength-um", type=float, help="select one wavelength of a multi-wavelength file")
+        p.add_argument("--wavelength-um", type=_finite(0.0, strict=True), help="select one wavelength of a multi-wavelength file")
         p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
         p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
-        p.add_argument("--seed", type=int, default=0)
+        p.add_argument("--seed", type=SEED, default=0)
 
     p = sub.add_parser("run", help="emcee posterior with corner, fit and residual plots and a report")
     data_options(p)
-    p.add_argument("--walkers", type=int, default=None)
-    p.add_argument("--steps", type=int, default=20000, help="cap on the chain length (steps)")
+    p.add_argument("--walkers", type=_int_at_least(2), default=None, help="even, >= 2 x parameters (default 32 or more)")
+    p.add_argument("--steps", type=_int_at_least(100), default=20000, help="cap on the chain length (steps)")
+    p.add_argument("--restart", action="store_true",
+                   help="start the chain afresh; an existing chain.h5 is kept aside as chain.h5.old")
     p.add_argument("--robust", action="store_true", help="Student-t likelihood (nu = 4) instead of Gaussian")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--reference", action="append", default=[], metavar="NAME=VALUE",
@@ -65,14 +99,14 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("compare", help="every optimizer, several seeds, against the posterior")
     data_options(p)
     p.add_argument("--methods", nargs="+", default=None)
-    p.add_argument("--seeds", type=int, default=3, help="runs per method")
+    p.add_argument("--seeds", type=_int_at_least(1), default=3, help="runs per method")
     p.add_argument("--out", default="reports/compare")
 
     p = sub.add_parser("diagnose", help="rank the registered effects that would explain the misfit")
     data_options(p)
     p.add_argument("--json", required=True, metavar="FILE", help="write the ranking here")
     p.add_argument("--candidates", nargs="+", default=None, help="effects to consider (default: every registered one)")
-    p.add_argument("--top", type=int, default=3, help="candidates confirmed by a full refit")
+    p.add_argument("--top", type=_int_at_least(1), default=3, help="candidates confirmed by a full refit")
     p.add_argument("--out", default="reports/diagnose")
 
     p = sub.add_parser("ladder", help="fit M, M + E1, M + E1 + E2, ...: the error falling rung by rung")
@@ -82,12 +116,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/ladder")
 
     p = sub.add_parser("sky", help="the sun (astropy) and the sky's polarization at a site and time; maps")
-    p.add_argument("--lat", type=float, required=True, metavar="DEG", help="latitude, north positive")
-    p.add_argument("--lon", type=float, required=True, metavar="DEG", help="longitude, east positive")
+    p.add_argument("--lat", type=_finite(), required=True, metavar="DEG", help="latitude, north positive")
+    p.add_argument("--lon", type=_finite(), required=True, metavar="DEG", help="longitude, east positive")
     p.add_argument("--time", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2020-12-16T11:42+08:00")
     p.add_argument("--model", default="rayleigh", choices=["rayleigh", "berry-dennis-lee"])
-    p.add_argument("--p-max", type=float, default=None, help="maximum DOP (default 1 for rayleigh, 0.8 for berry-dennis-lee)")
-    p.add_argument("--delta-deg", type=float, default=20.0, help="berry-dennis-lee: neutral points' distance from the sun")
+    p.add_argument("--p-max", type=_finite(0.0), default=None, help="maximum DOP (default 1 for rayleigh, 0.8 for berry-dennis-lee)")
+    p.add_argument("--delta-deg", type=_finite(0.0), default=20.0, help="berry-dennis-lee: neutral points' distance from the sun")
     p.add_argument("--direction", action="append", default=[], metavar="ZENITH,AZIMUTH",
                    help="a direction (deg) at which to report DOP and AoP (repeatable)")
     p.add_argument("--out", default="reports/sky")
@@ -97,8 +131,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--scenario", metavar="FILE.toml", help="default: the paper's section 4 and Table 2")
     p.add_argument("--reading", default="corrected", choices=["corrected", "paper"],
                    help="micro-polarizer: superpixel mean 1/2 (corrected) or (1 + P)/2 (paper)")
-    p.add_argument("--draws", type=int, default=20000)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--draws", type=_int_at_least(100), default=20000, help="posterior draws pushed through (>= 100)")
+    p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/contrast")
     for p in sub.choices.values():  # --effect also after the command name, where users put it
         p.add_argument("--effect", action="append", default=[], dest="effect_after", metavar="FILE.py:NAME",
@@ -108,6 +142,12 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
+    import os
+    import warnings
+
+    if not os.environ.get("SPACEPOL_SHOW_WARNINGS"):  # third-party deprecation chatter is not for users
+        warnings.filterwarnings("ignore", category=FutureWarning)
+        warnings.filterwarnings("ignore", category=DeprecationWarning)
     from . import commands
     from .errors import SpacepolError
 
@@ -124,8 +164,21 @@ def main(argv=None) -> int:
         sys.stderr.close()
         return 0
     except KeyboardInterrupt:
-        print("invert-mcmc: interrupted", file=sys.stderr)
+        print("invert-mcmc: interrupted; the same command continues where it stopped", file=sys.stderr)
         return 130
+    except OSError as exc:  # the file system said no (disk full, permissions changed mid-run, ...)
+        where = f" {exc.filename}" if exc.filename else ""
+        print(f"invert-mcmc: error:{where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("invert-mcmc: error: out of memory; use fewer geometries, walkers or draws", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a bug of ours: say so in one line; the traceback on request
+        if os.environ.get("SPACEPOL_TRACEBACK"):
+            raise
+        print(f"invert-mcmc: internal error: {type(exc).__name__}: {exc} "
+              f"(a bug in spacepol; set SPACEPOL_TRACEBACK=1 for the traceback and report it)", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ import numpy as np
 
 from .errors import ParameterError, SpacepolError
 from .io import Dataset, read_measurements, write_table
+from .io.output import check_output_dir, check_output_file
 from .physics.geometry import Geometry, default_grid
 from .physics.model import Model, build_model
 
@@ -41,10 +42,11 @@ def _prediction_columns(geometry: Geometry, prediction) -> dict:
 
 
 def forward(args) -> int:
+    check_output_file(args.out)
     model = build_model(args.model)
     values = parse_settings(args.set, model)
     data = read_measurements(args.geometry, require_observable=False)
-    prediction = model.evaluate(values, data.geometry)
+    prediction = model.check_plugins({**model.defaults(), **values}, data.geometry)
     columns = _prediction_columns(data.geometry, prediction)
     if data.wavelength_um is not None:
         columns["wavelength_um"] = data.wavelength_um
@@ -55,6 +57,7 @@ def forward(args) -> int:
 
 
 def synth(args) -> int:
+    check_output_file(args.out)
     model = build_model(args.model)
     values = {**model.defaults(), **parse_settings(args.set, model)}
     if args.noise_dop < 0 or (args.noise_brdf is not None and args.noise_brdf < 0):
@@ -71,7 +74,7 @@ def synth(args) -> int:
     if wavelength is not None:
         geometry = Geometry(geometry.theta_i, geometry.theta_r, geometry.dphi, wavelength)
     rng = np.random.default_rng(args.seed)
-    prediction = model.evaluate(values, geometry)
+    prediction = model.check_plugins(values, geometry)
     dop = np.clip(prediction.dop + rng.normal(0.0, args.noise_dop, geometry.size), 0.0, 1.0)
     columns = {"theta_i": geometry.theta_i, "theta_r": geometry.theta_r, "dphi": geometry.dphi, "dop": dop}
     if args.noise_dop > 0:
@@ -122,6 +125,7 @@ def effects(args) -> int:
 def demo(args) -> int:
     from .report.demo import run_demo
 
+    check_output_dir(args.out)
     run_demo(Path(args.out))
     return 0
 
@@ -139,13 +143,30 @@ def load_dataset(args) -> Dataset:
     return data
 
 
+def parse_observables(text: str | None) -> list[str] | None:
+    """``--observables dop,brdf`` -> ["dop", "brdf"]; empty, unknown or repeated names are errors."""
+    if text is None:
+        return None
+    from .infer.likelihood import OBSERVABLES
+
+    names = [o.strip() for o in text.split(",")]
+    for name in names:
+        if not name:
+            raise ParameterError(f"--observables '{text}': an empty name (use e.g. dop,brdf)")
+        if name not in OBSERVABLES:
+            raise ParameterError(f"--observables '{text}': unknown observable '{name}' (use {', '.join(OBSERVABLES)})")
+        if names.count(name) > 1:
+            raise ParameterError(f"--observables '{text}': '{name}' named twice (each observable counts once)")
+    return names
+
+
 def build_posterior(args, data, robust=False):
     from .infer.posterior import Posterior
     from .infer.prior_set import read_prior_file
 
     model = build_model(args.model)
     overrides = read_prior_file(args.prior) if args.prior else None
-    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    observables = parse_observables(args.observables)
     return Posterior.build(data, model, overrides, observables=observables, robust=robust,
                            where=args.prior or "priors")
 
@@ -166,26 +187,63 @@ def parse_references(items, posterior) -> dict[str, float]:
 
 
 def run(args) -> int:
-    from .infer.inversion import invert
+    from .infer.chain_file import set_aside
+    from .infer.inversion import check_resumable, check_walkers, invert
+    from .io.output import folder_lock
     from .report.run_report import write_run_report
 
-    if args.steps < 100:
-        raise ParameterError(f"--steps {args.steps}: need at least 100")
+    out = check_output_dir(args.out)
     data = load_dataset(args)
     posterior = build_posterior(args, data, robust=args.robust)
     references = parse_references(args.reference, posterior)
-    out = Path(args.out)
+    check_walkers(args.walkers, posterior.ndim)
+    if not args.restart:
+        check_resumable(out / "chain.h5", posterior, args.walkers, args.seed)
     if not args.quiet:
         print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
               f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}", file=sys.stderr)
-    out.mkdir(parents=True, exist_ok=True)
-    inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,
-                 backend_path=out / "chain.h5", progress=not args.quiet)
-    summary = write_run_report(inv, out, args.data, references=references)
+    made_folder = not out.exists()
+    chain = out / "chain.h5"
+    with folder_lock(out):
+        if args.restart and (old := set_aside(chain)) is not None and not args.quiet:
+            print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
+        fresh = not chain.exists()
+        try:
+            inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,
+                         backend_path=chain, progress=not args.quiet)
+        except KeyboardInterrupt:
+            raise  # the chain so far is kept: the same command continues it
+        except BaseException:
+            _discard_unstarted(chain, out, fresh, made_folder)
+            raise
+        if not args.quiet:
+            print("  writing the report (figures, posterior.nc, summary.json, report.html)", file=sys.stderr)
+        summary = write_run_report(inv, out, args.data, references=references)
+    for flag in summary["identifiability"].get("at_bound", []):
+        from .infer.identifiability import bound_finding
+
+        print(f"warning: {bound_finding(flag)}")
     d = summary["diagnostics"]
     print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, residual_trends.png, report.html "
           f"(R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")
     return 0
+
+
+def _discard_unstarted(chain: Path, out: Path, fresh: bool, made_folder: bool) -> None:
+    """A run that failed before its first stored step leaves nothing behind that would block the
+    corrected command (a chain stamped with the failed run's settings would)."""
+    from .infer.chain_file import ChainFileError, chain_iterations
+
+    try:
+        empty = fresh and chain.exists() and chain_iterations(chain) == 0
+    except ChainFileError:
+        empty = fresh
+    if empty:
+        chain.unlink(missing_ok=True)
+    if made_folder and out.is_dir() and not any(p.name != ".spacepol.lock" for p in out.iterdir()):
+        import shutil
+
+        shutil.rmtree(out, ignore_errors=True)
 
 
 def optimize(args) -> int:
@@ -196,6 +254,9 @@ def optimize(args) -> int:
     from .infer.prior_set import PriorSet
     from .io.atomic import _jsonable
 
+    from .infer.engines import check_method
+
+    check_method(args.method)
     data = load_dataset(args)
     if args.method == "emcee":
         from .infer.inversion import invert
@@ -216,6 +277,11 @@ def optimize(args) -> int:
 def compare(args) -> int:
     from .report.compare import run_comparison
 
+    from .infer.engines import check_method
+
+    check_output_dir(args.out)
+    for method in args.methods or []:
+        check_method(method)
     data = load_dataset(args)
     posterior = build_posterior(args, data)
     run_comparison(posterior, data, Path(args.out), methods=args.methods, seeds=args.seeds, base_seed=args.seed)
@@ -230,6 +296,8 @@ def diagnose(args) -> int:
 
     from .infer.prior_set import read_prior_file
 
+    check_output_file(args.json, "--json")
+    check_output_dir(args.out)
     model = build_model(args.model)
     priors = read_prior_file(args.prior) if args.prior else None
     for name in args.candidates or []:
@@ -237,7 +305,7 @@ def diagnose(args) -> int:
     if args.top < 1:
         raise ParameterError(f"--top {args.top}: need at least 1")
     data = load_dataset(args)
-    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    observables = parse_observables(args.observables)
     report = run_diagnose(data, model, np.random.default_rng(args.seed), seed=args.seed, observables=observables,
                           candidates=args.candidates, top=args.top, priors=priors)
     base, confirmed = report.pop("_base"), report.pop("_confirmed")
@@ -256,12 +324,15 @@ def ladder(args) -> int:
     from .criticism.ladder import climb
     from .report.ladder_report import write_ladder_report
 
+    check_output_dir(args.out)
+    if args.json:
+        check_output_file(args.json, "--json")
     model = build_model(args.model)
     current = model
     for name in args.add:  # check the whole ladder composes before fitting anything
         current = current + name
     data = load_dataset(args)
-    observables = [o.strip() for o in args.observables.split(",")] if args.observables else None
+    observables = parse_observables(args.observables)
     rungs = climb(data, model, args.add, seed=args.seed, observables=observables)
     out = Path(args.out)
     print("\n".join(write_ladder_report(rungs, out, args.json)))
@@ -287,6 +358,7 @@ def sky(args) -> int:
     from .sky.rayleigh import RayleighSky
     from .sky.sun import sun_position
 
+    check_output_dir(args.out)
     directions = [_parse_direction(d) for d in args.direction]
     if args.model == "rayleigh":
         model = RayleighSky(1.0 if args.p_max is None else args.p_max)
@@ -328,9 +400,7 @@ def contrast(args) -> int:
     from .report.contrast_report import make_contrast_report, table3_lines
 
     scenario = read_scenario(args.scenario) if args.scenario else default_scenario()
-    if args.draws < 100:
-        raise ParameterError(f"--draws {args.draws}: need at least 100 for 90 % intervals")
-    out = Path(args.out) if args.out else Path(args.run_dir) / "contrast"
+    out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "contrast")
     report = make_contrast_report(args.run_dir, scenario, out, args.reading, args.draws, args.seed)
     print("\n".join(table3_lines(report)))
     print(report["dominance"])

@@ -13,11 +13,13 @@
 from __future__ import annotations
 
 import re
+import sys
 import time
 
 import numpy as np
 
 from ..errors import SpacepolError
+from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.inference_data import median_fit, standardise
 from ..infer.inversion import invert
 from ..infer.optimum import find_optimum
@@ -105,32 +107,37 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
     base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
+    all_candidates = _candidates(model, data, candidates)
     if base is None:
         if progress:
-            print(f"  fitting {model.name} ...", flush=True)
+            _say(f"[base] fitting {model.name} with emcee ({len(data)} geometries) ...")
         base = invert(base_post, seed=seed, max_steps=max_steps, progress=False, centre=_vector(base_optimum, base_post))
     base_loo = base.loo["pointwise"]
     base_fit = median_fit(base.posterior, base.result.flat_samples())
     clock["base"] = time.perf_counter()
 
+    if progress:
+        _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
     screened = []
-    for name, candidate in _candidates(model, data, candidates):
+    for i, (name, candidate) in enumerate(all_candidates, start=1):
         post = _build(data, candidate, observables, priors)
         best, optimum = _screen(post, rng, screening_evaluations, seeds=nested_seeds(base_optimum, candidate, post))
         gain = best - base_best
         screened.append({"effect": name, "model": candidate, "posterior": post, "screening_gain": float(gain),
                          "optimum": _vector(optimum, post)})
         if progress:
-            print(f"  screening {name:<18s} max log posterior gain {gain:9.2f}", flush=True)
+            _say(f"[screen {i}/{len(all_candidates)}] {name:<18s} max log posterior gain {gain:9.2f} "
+                 f"({time.perf_counter() - clock['start']:.0f} s)")
     screened.sort(key=lambda c: -c["screening_gain"])
 
     clock["screening"] = time.perf_counter()
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
     to_confirm = screened[:top] + [c for c in screened[top:] if screened and _close(c["screening_gain"], screened[0]["screening_gain"])]
     confirmed = []
-    for c in to_confirm:
+    for i, c in enumerate(to_confirm, start=1):
         if progress:
-            print(f"  confirming {c['effect']} with emcee ...", flush=True)
+            _say(f"[confirm {i}/{len(to_confirm)}] {c['effect']}: emcee posterior and PSIS-LOO "
+                 f"({time.perf_counter() - clock['start']:.0f} s)")
         # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
         inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False, centre=c["optimum"])
         diff = inv.loo["pointwise"] - base_loo
@@ -171,6 +178,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)},
             "_base": base, "_confirmed": confirmed}
+
+
+def _say(text: str) -> None:
+    print(f"  {text}", file=sys.stderr, flush=True)
 
 
 def signatures(base, inv, base_fit=None) -> dict:
@@ -215,8 +226,10 @@ def _close(a: float, b: float) -> bool:
 
 
 def _structured(summary) -> bool:
-    """Residuals still carry structure: misfit above the noise floor, or runs/trends flagged."""
-    return summary["fit"]["chi2_red"] > 1.5 or summary["residual_structure"]["structured"]
+    """Residuals still carry structure: runs/trends flagged, or (with known noise only) a misfit above
+    the noise floor; with inferred noise chi^2 ~ 1 by construction and says nothing."""
+    above_floor = not inferred_noise_levels(summary) and summary["fit"]["chi2_red"] > 1.5
+    return above_floor or summary["residual_structure"]["structured"]
 
 
 def _conclusion(base, confirmed, verdict) -> str:
@@ -224,7 +237,7 @@ def _conclusion(base, confirmed, verdict) -> str:
     if verdict == "none":
         if _structured(base.summary):
             return ("No candidate in the library improves ELPD-LOO by more than 2 SE (and 4), yet the residuals of "
-                    f"{base.summary['model']} are structured (reduced chi^2 {base.summary['fit']['chi2_red']:.2f}; "
+                    f"{base.summary['model']} are structured ({describe_fit(base.summary)}; "
                     "see residual_structure): an effect outside the library is likely. Write it as a plug-in "
                     "effect and rerun diagnose.")
         return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary['model']} "
@@ -232,12 +245,12 @@ def _conclusion(base, confirmed, verdict) -> str:
     after = next(c for c in confirmed if c["effect"] == verdict)["inversion"].summary
     text = f"Add {verdict}: it is the candidate that improves ELPD-LOO most, by more than 2 SE."
     if _structured(after):
-        text += (f" After adding it the residuals are still structured (reduced chi^2 {after['fit']['chi2_red']:.2f}"
+        text += (f" After adding it the residuals are still structured ({describe_fit(after)}"
                  + "; " + " ".join(after["residual_structure"]["findings"])
                  + "): run diagnose again on the extended model; if nothing else in the library helps, the rest comes "
                  "from an effect outside it.")
     else:
-        text += f" After adding it the residuals look like noise (reduced chi^2 {after['fit']['chi2_red']:.2f})."
+        text += f" After adding it the residuals look like noise ({describe_fit(after)})."
     return text
 
 
@@ -253,7 +266,10 @@ def _explain(c, base) -> str:
     cls = registry.get(c["effect"])
     physics = _first_sentence(cls.description)
     rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c["rmse_dop_after"]
-    change = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
+    rmse = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
+    noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c["inversion"].summary)
+    if noise0:
+        rmse += "inferred noise " + ", ".join(f"{k} {noise0[k]:.3g} -> {noise1.get(k, float('nan')):.3g}" for k in noise0) + "; "
     verdict = "significant" if c["significant"] else "not significant (gain within 2 SE or below 4)"
     why = []
     data = base.posterior.likelihood.data
@@ -263,4 +279,4 @@ def _explain(c, base) -> str:
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
                    f"correlates {s['correlation']:+.2f} with the residuals and {change}")
     return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
-            f"{change}" + "; ".join(why) + ".")
+            f"{rmse}" + "; ".join(why) + ".")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ..infer.inversion import invert
@@ -21,7 +23,7 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
         inv = fitted.get(current.name)
         if inv is None:
             if progress:
-                print(f"  fitting {current.name} ...", flush=True)
+                print(f"  [rung {len(rungs)}/{len(additions)}] fitting {current.name} with emcee ...", file=sys.stderr, flush=True)
             post = Posterior.build(data, current, observables=observables)
             centre = None
             if rungs:  # start from the previous rung's optimum, the new effect at its neutral values
@@ -31,6 +33,17 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
         fit = inv.summary["fit"]
         rungs.append({"model": current.name, "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
+                      "inferred_noise": inferred_noise(inv), "noise_known": not inferred_noise(inv),
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"], "parameters": inv.summary["parameters"],
                       "_inversion": inv})
     return rungs
+
+
+def inferred_noise(inv) -> dict[str, float]:
+    """{nuisance name: posterior median} for each observable whose noise the fit inferred.
+
+    With inferred noise the reduced chi^2 is ~1 by construction: the noise parameter grows to
+    absorb whatever the model misses.  That inferred level is then the error that falls."""
+    lik = inv.posterior.likelihood
+    names = [lik.noise_parameter(o) for o in lik.observables]
+    return {n: inv.summary["parameters"][n]["median"] for n in dict.fromkeys(names) if n is not None}

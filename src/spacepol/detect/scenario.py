@@ -8,8 +8,11 @@ The defaults are the paper's (section 4 and Table 2); ``default_scenario()`` ret
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import SpacepolError
 from ..io.toml_file import read_toml
@@ -86,6 +89,8 @@ def _value(where: str, key: str, raw, spec):
             raise SpacepolError(f"{where}: '{key}' = '{raw}': unit {quantity.unit} cannot be converted to {shown}") from None
     else:
         value = float(raw)
+    if not math.isfinite(value):
+        raise SpacepolError(f"{where}: '{key}' = {raw!r} must be a finite number")
     if check == "positive" and not value > 0:
         raise SpacepolError(f"{where}: '{key}' = {value:g} must be > 0")
     if check == "nonnegative" and value < 0:
@@ -141,4 +146,31 @@ def read_scenario(path) -> Scenario:
         raise SpacepolError(f"{path} [sky]: p_max_low must not exceed p_max_high")
     if s.sky["model"] not in ("rayleigh", "berry-dennis-lee"):
         raise SpacepolError(f"{path} [sky]: model '{s.sky['model']}' unknown (rayleigh, berry-dennis-lee)")
+    check_scenario(s, str(path))
     return s
+
+
+def check_scenario(s: Scenario, where: str) -> None:
+    """Checks that need several keys at once, or a computation: the site, the time, a band whose flux
+    is finite and positive (a band far from the star's spectrum underflows to zero photons)."""
+    from ..sky.sun import parse_time
+    from .radiometry import magnitude
+
+    if not -90 <= s.site["lat_deg"] <= 90:
+        raise SpacepolError(f"{where} [site]: 'lat_deg' = {s.site['lat_deg']:g} must lie in [-90, 90]")
+    if not -180 <= s.site["lon_deg"] <= 360:
+        raise SpacepolError(f"{where} [site]: 'lon_deg' = {s.site['lon_deg']:g} must lie in [-180, 360]")
+    try:
+        parse_time(s.site["time"])
+    except SpacepolError as exc:
+        raise SpacepolError(f"{where} [site]: 'time': {str(exc).split(': ', 1)[-1]}") from None
+    with np.errstate(all="ignore"):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = float(magnitude(s.instrument["limit_flux_photons_m2_s"], s.instrument))
+    if not math.isfinite(m):
+        raise SpacepolError(f"{where} [instrument]: the band {s.instrument['band_low_um']:g}-{s.instrument['band_high_um']:g} um "
+                            f"holds no finite photon flux of a {s.instrument['star_temperature_K']:g} K star "
+                            f"(eq 39 gives magnitude {m}); choose a band where the star emits")

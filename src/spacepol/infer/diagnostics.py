@@ -58,3 +58,20 @@ def quantiles(result: Result) -> dict:
         q = np.percentile(flat[:, j], [5, 16, 50, 84, 95])
         out[name] = {"median": float(q[2]), "q05": float(q[0]), "q16": float(q[1]), "q84": float(q[3]), "q95": float(q[4])}
     return out
+
+
+NUISANCE_NOISE = ("sigma_dop", "sigma_brdf_rel", "sigma_qu")
+
+
+def inferred_noise_levels(summary: dict) -> dict[str, float]:
+    """{nuisance: posterior median} of the noise levels a run inferred (empty when the file gave errors)."""
+    return {n: summary["parameters"][n]["median"] for n in NUISANCE_NOISE if n in summary.get("parameters", {})}
+
+
+def describe_fit(summary: dict) -> str:
+    """The error measure that means something for this fit: reduced chi^2 with known noise; with
+    inferred noise (chi^2 ~ 1 by construction) the inferred noise levels."""
+    noise = inferred_noise_levels(summary)
+    if noise:
+        return "inferred noise " + ", ".join(f"{k} {v:.3g}" for k, v in noise.items())
+    return f"reduced chi^2 {summary['fit']['chi2_red']:.2f}"

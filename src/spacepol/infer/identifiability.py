@@ -44,11 +44,49 @@ def _intensity_ratio_findings(flat, names, lobe):
     return out
 
 
+NEAR_BOUND_U = 0.1  # median within the outer 10 % of the prior's probability ...
+BOUND_REACH_SD = 3.5  # ... and the bound within 3.5 posterior sd of it: the bound truncates the posterior
+
+
+def at_bounds(posterior: Posterior, flat: np.ndarray, names: list[str]) -> list[dict]:
+    """Parameters whose posterior piles against a bound of the prior.
+
+    Judged in the prior's own unit cube (u = prior CDF, so uniform, log-uniform and normal priors
+    are treated alike): the median lies in the outer 10 % of the prior mass and the bound is within
+    3.5 posterior standard deviations (from the 16th-50th percentile spread) of it.  A flat,
+    unconstrained posterior (median mid-prior) is not flagged; a narrow one far from the bound neither."""
+    u = posterior.priors.to_unit(flat)
+    physical = {p.name: p.physical for p in posterior.priors.parameters}
+    out = []
+    for j, name in enumerate(names):
+        q16, med, q84 = np.percentile(u[:, j], [16, 50, 84])
+        for side, dist, spread, bound in (("lower", med, med - q16, posterior.priors.priors[name].lower),
+                                          ("upper", 1.0 - med, q84 - med, posterior.priors.priors[name].upper)):
+            if dist < NEAR_BOUND_U and dist <= BOUND_REACH_SD * max(spread, 1e-12):
+                x = flat[:, j]
+                lo, mid, hi = np.percentile(x, [5, 50, 95])
+                is_physical = bound == physical[name][0 if side == "lower" else 1]
+                out.append({"parameter": name, "side": side, "bound": float(bound), "physical_limit": bool(is_physical),
+                            "median": float(mid), "q05": float(lo), "q95": float(hi)})
+    return out
+
+
+def bound_finding(flag: dict) -> str:
+    name, b = flag["parameter"], flag["bound"]
+    where = f"(median {flag['median']:.4g}, 90 % [{flag['q05']:.4g}, {flag['q95']:.4g}])"
+    if flag["physical_limit"]:
+        return (f"{name} sits at its physical limit {b:g} {where}: possible only if the material really has "
+                f"{name} = {b:g}; otherwise the model is wrong and {name} is absorbing a missing effect.")
+    return (f"{name} sits at its {flag['side']} bound {b:g} {where}: the model or the prior is wrong "
+            f"(the posterior is cut off by the prior, so its interval is not a measurement).")
+
+
 def identifiability(posterior: Posterior, result: Result) -> dict:
     flat = result.flat_samples()
     names = result.names
     rng = np.random.default_rng(0)
-    findings, weak = [], []
+    bounds = at_bounds(posterior, flat, names)
+    findings, weak = [bound_finding(f) for f in bounds], []
     ratios = {}
     for j, name in enumerate(names):
         post_width = float(np.subtract(*np.percentile(flat[:, j], [95, 5])))
@@ -70,6 +108,6 @@ def identifiability(posterior: Posterior, result: Result) -> dict:
     for a, b, r in pairs:
         findings.append(f"{a} and {b} are strongly correlated (r = {r:+.2f}): the data fix a combination of them better than either.")
     if not findings:
-        findings.append("Every parameter is well constrained and no pair is strongly correlated.")
-    return {"width_ratio": ratios, "weak": weak, "correlated_pairs": [list(p) for p in pairs],
+        findings.append("Every parameter is well constrained, away from its prior bounds, and no pair is strongly correlated.")
+    return {"width_ratio": ratios, "weak": weak, "correlated_pairs": [list(p) for p in pairs], "at_bound": bounds,
             "correlation": corr.tolist(), "findings": findings}

@@ -110,3 +110,25 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
     })
     idata.posterior_predictive.attrs["mean_prediction"] = "y_rep = model + noise drawn as in the likelihood"
     return idata
+
+
+def for_storage(idata: az.InferenceData, max_values: int = 3_000_000) -> az.InferenceData:
+    """A copy small enough to keep: the posterior, sample_stats and data groups whole; the
+    pointwise groups (log_likelihood, posterior_predictive), which grow with the number of
+    observations, thinned to at most ``max_values`` numbers each (every k-th draw of every chain)
+    and stored as float32 (7 significant digits, far below Monte-Carlo error).  The summary's
+    R-hat, ESS and ELPD-LOO were computed on the full groups before thinning."""
+    out = idata.copy()
+    for group in ("log_likelihood", "posterior_predictive"):
+        if group not in out.groups():
+            continue
+        ds = out[group]
+        per_draw = sum(int(np.prod([n for d, n in v.sizes.items() if d not in ("chain", "draw")])) for v in ds.data_vars.values())
+        total = ds.sizes["chain"] * ds.sizes["draw"] * max(per_draw, 1)
+        step = max(1, int(np.ceil(total / max_values)))
+        thinned = ds.isel(draw=slice(None, None, step)).astype(np.float32)
+        thinned.attrs.update(ds.attrs)
+        thinned.attrs["stored_every_kth_draw"] = step
+        thinned.attrs["note"] = "thinned and float32 for storage; summary.json holds the full-chain statistics"
+        setattr(out, group, thinned)
+    return out

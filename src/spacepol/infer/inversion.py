@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 
 from ..errors import SpacepolError
+from .chain_file import chain_iterations
 from .diagnostics import convergence, fit_statistics, loo, quantiles
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
@@ -45,16 +46,30 @@ def fingerprint(posterior: Posterior, walkers: int, seed: int) -> str:
 def _check_backend(path: Path, print_: str) -> None:
     if not path.exists():
         return
+    chain_iterations(path)  # a damaged file: one line with the remedy
     with h5py.File(path, "r") as f:
         stored = f.attrs.get("spacepol_fingerprint")
     if stored is not None and stored != print_:
         raise SpacepolError(f"{path}: holds the chain of a different run (model, data, priors, walkers or seed); "
-                            f"delete it or use another --out")
+                            f"add --restart to start afresh (the old chain is kept as {path.name}.old) or use another --out")
 
 
 def _stamp_backend(path: Path, print_: str) -> None:
     with h5py.File(path, "a") as f:
         f.attrs["spacepol_fingerprint"] = print_
+
+
+def check_resumable(path, posterior: Posterior, walkers: int | None, seed: int) -> None:
+    """Before any work: a chain already in ``path`` must be readable and belong to this run."""
+    _check_backend(Path(path), fingerprint(posterior, check_walkers(walkers, posterior.ndim), seed))
+
+
+def check_walkers(walkers: int | None, ndim: int) -> int:
+    """The number of walkers to use (the default when None); an impossible count is an error."""
+    walkers = default_walkers(ndim) if walkers is None else walkers
+    if walkers < 2 * ndim or walkers % 2:
+        raise SpacepolError(f"--walkers {walkers}: need an even number >= 2 x {ndim} parameters = {2 * ndim}")
+    return walkers
 
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
@@ -63,9 +78,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     around which the walkers start; by default a global optimisation finds one."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
-    walkers = walkers or default_walkers(posterior.ndim)
-    if walkers < 2 * posterior.ndim or walkers % 2:
-        raise SpacepolError(f"--walkers {walkers}: need an even number >= 2 x {posterior.ndim} parameters")
+    walkers = check_walkers(walkers, posterior.ndim)
     if backend_path is not None:
         backend_path = Path(backend_path)
         print_ = fingerprint(posterior, walkers, seed)
@@ -93,7 +106,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
     ident = identifiability(posterior, result)
-    summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "findings", "width_ratio")}
+    summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
     from ..criticism.residuals import analyse
 
     structure = analyse(posterior, result.flat_samples())

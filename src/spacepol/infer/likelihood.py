@@ -36,6 +36,10 @@ class Likelihood:
         self.data, self.model = data, model
         available = [o for o in OBSERVABLES if getattr(data, o) is not None]
         self.observables = list(observables) if observables else [o for o in available if o in DEFAULT_OBSERVABLES]
+        repeated = sorted({o for o in self.observables if self.observables.count(o) > 1})
+        if repeated:
+            raise ParameterError(f"observables {','.join(self.observables)}: {', '.join(repeated)} named twice "
+                                 f"(each observable counts once)")
         for name in self.observables:
             if name not in OBSERVABLES:
                 raise ParameterError(f"unknown observable '{name}' (use {', '.join(OBSERVABLES)})")

@@ -25,7 +25,29 @@ class Posterior:
     def build(cls, data, model, prior_overrides=None, observables=None, robust=False, where="priors"):
         likelihood = Likelihood(data, model, observables=observables, robust=robust)
         priors = PriorSet(model.parameters + likelihood.nuisance, prior_overrides, where=where)
-        return cls(likelihood, priors)
+        posterior = cls(likelihood, priors)
+        posterior.check_support(where)
+        return posterior
+
+    def check_support(self, where: str = "priors", draws: int = 256) -> None:
+        """Before any sampling: plug-in effects give finite predictions, and the posterior is finite
+        somewhere in the prior support (else one line says which part is at fault).  Uses its own
+        fixed-seed generator, so the user's random stream is untouched."""
+        rng = np.random.default_rng(20261122)
+        theta = np.vstack([self.priors.rescale(np.full((1, self.ndim), 0.5)), self.priors.sample(rng, draws)])
+        names = {p.name for p in self.likelihood.model.parameters}
+        params = {k: v for k, v in self.priors.to_params(theta).items() if k in names}
+        self.likelihood.model.check_plugins(params, self.likelihood.data.geometry)
+        lp = self.priors.ln_prob(theta)
+        if not np.any(np.isfinite(lp)):
+            raise ParameterError(f"{where}: the prior density is zero at every one of {len(theta)} draws from it")
+        if self.prior_only:
+            return
+        ll = self.log_prob_pointwise(theta).sum(axis=-1)
+        if not np.any(np.isfinite(ll)):
+            raise ParameterError(
+                f"{self.likelihood.data.source}: the likelihood is not finite at any of {len(theta)} draws from the "
+                f"priors ({where}); the model cannot produce these data anywhere the priors allow")
 
     @property
     def ndim(self) -> int:

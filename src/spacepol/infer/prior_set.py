@@ -41,7 +41,12 @@ def prior_from_table(name: str, table: dict, where: str) -> Prior:
     if "fixed" in table:
         if len(table) > 1:
             raise ParameterError(f"{where}: [{name}] 'fixed' cannot be combined with other keys")
-        return Fixed(_float(table["fixed"], name, "fixed", where))
+        try:
+            return Fixed(_float(table["fixed"], name, "fixed", where))
+        except ParameterError as exc:
+            if str(exc).startswith(where):
+                raise
+            raise ParameterError(f"{where}: [{name}] {exc}") from None
     kind = table.get("distribution", "uniform")
     try:
         lower = _float(table["lower"], name, "lower", where)
@@ -63,6 +68,8 @@ def prior_from_table(name: str, table: dict, where: str) -> Prior:
 def _float(value, name, key, where):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(f"{where}: [{name}] {key} must be a number, got {value!r}")
+    if not np.isfinite(value):
+        raise ParameterError(f"{where}: [{name}] {key} must be a finite number, got {value!r}")
     return float(value)
 
 

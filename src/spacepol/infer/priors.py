@@ -103,8 +103,15 @@ class TruncatedNormal(Prior):
 
     def __post_init__(self):
         _check_interval(self.lower, self.upper, "TruncatedNormal prior")
-        if not self.sigma > 0:
-            raise ParameterError(f"TruncatedNormal prior: sigma must be > 0, got {self.sigma}")
+        if not np.isfinite(self.mu):
+            raise ParameterError(f"TruncatedNormal prior: mu must be finite, got {self.mu}")
+        if not (self.sigma > 0 and np.isfinite(self.sigma)):
+            raise ParameterError(f"TruncatedNormal prior: sigma must be finite and > 0, got {self.sigma}")
+        lo, hi = self._cdf_bounds()
+        if not hi - lo > 1e-300:
+            raise ParameterError(f"normal(mu={self.mu:g}, sigma={self.sigma:g}) puts no probability on "
+                                 f"[{self.lower:g}, {self.upper:g}] (mu lies {min(abs(self.mu - self.lower), abs(self.mu - self.upper)) / self.sigma:.3g} "
+                                 f"sigma outside it)")
 
     def _cdf_bounds(self):
         a = (self.lower - self.mu) / self.sigma
@@ -131,6 +138,10 @@ class Fixed(Prior):
     """A parameter held at one value: not sampled, not searched."""
 
     value: float
+
+    def __post_init__(self):
+        if not np.isfinite(self.value):
+            raise ParameterError(f"fixed value must be a finite number, got {self.value}")
 
     @property
     def lower(self):  # type: ignore[override]

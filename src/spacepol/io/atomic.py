@@ -1,4 +1,9 @@
-"""Write files atomically: a temporary file in the same folder, renamed into place."""
+"""Write files atomically: a temporary file in the same folder, renamed into place.
+
+The temporary file is made by ``mkstemp`` (mode 0600); before the rename it gets the mode an
+ordinary ``open(..., "w")`` would have given it (0666 less the umask), so outputs follow the
+user's umask like any other file they write.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +16,17 @@ from pathlib import Path
 import numpy as np
 
 
+def _umask() -> int:
+    mask = os.umask(0)  # the only portable way to read it: set and restore at once
+    os.umask(mask)
+    return mask
+
+
+def file_mode() -> int:
+    """The mode a new regular file gets here: 0666 less the process umask."""
+    return 0o666 & ~_umask()
+
+
 @contextmanager
 def atomic_path(path):
     """Yield a temporary path; on success it replaces ``path``, on failure it is removed."""
@@ -20,6 +36,7 @@ def atomic_path(path):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, file_mode())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -46,6 +63,12 @@ def write_json(path, data) -> None:
         tmp.write_text(json.dumps(_jsonable(data), indent=2) + "\n", encoding="utf-8")
 
 
-def save_figure(fig, path, dpi=120) -> None:
+def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=dpi)
+        tmp.write_text(text, encoding="utf-8")
+
+
+def save_figure(fig, path, dpi=120) -> None:
+    # "tight" keeps labels that reach past the axes (sky-map titles, rotated ticks) on the page.
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=dpi, bbox_inches="tight")

@@ -136,10 +136,12 @@ def _number(text, path, line, column):
 def read_measurements(path, require_observable: bool = True) -> Dataset:
     """Read a spacepol CSV or a NIST Mueller BRDF file."""
     path = Path(path)
+    if path.is_dir():
+        raise InputFileError(path, "is a folder, not a measurement file")
     if not path.is_file():
         raise InputFileError(path, "file not found")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # "-sig": spreadsheets save "CSV UTF-8" with a byte-order mark
     except UnicodeDecodeError as exc:
         raise InputFileError(path, f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     lines = text.splitlines()
@@ -194,6 +196,8 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     wavelength = arrays.get("wavelength_um")
     if wavelength is None and "wavelength_um" in meta:
         wl = _number(meta["wavelength_um"], path, None, "wavelength_um metadata")
+        if wl <= 0:
+            raise InputFileError(path, f"metadata wavelength_um {wl:g} um must be positive")
         wavelength = np.full(n, wl)
     stokes = None
     if len(stokes_cols) == 3:

@@ -46,8 +46,18 @@ def read_nist_rows(path, header, lines, header_line, meta):
         for col in (1, 3):
             if abs(values[col]) >= 90:
                 raise InputFileError(path, f"angle {values[col]:g} deg: |angle| must be below 90", line=line, column=header[col])
+        if values[0] <= 0:
+            raise InputFileError(path, f"wavelength {values[0]:g} um must be positive", line=line, column=header[0])
         if values[5] < 0:
             raise InputFileError(path, f"negative BRDF {values[5]:g}", line=line, column=header[5])
+        for i in range(6, 21):
+            if abs(values[i]) > 1:
+                raise InputFileError(path, f"normalised Mueller element {values[i]:g} outside [-1, 1]", line=line, column=header[i])
+        # first column (m21, m31, m41): the state unpolarized light leaves in; its degree cannot exceed 1
+        dop_row = float(np.sqrt(values[9] ** 2 + values[13] ** 2 + values[17] ** 2))
+        if dop_row > 1:
+            raise InputFileError(path, f"m21, m31, m41 imply DOP {dop_row:.4g} > 1 for unpolarized light", line=line,
+                                 column=f"{header[9]}, {header[13]}, {header[17]}")
         rows.append(values)
     if not rows:
         raise InputFileError(path, "empty file: header but no data rows", line=header_line)

@@ -6,11 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, SpacepolError, UnknownNameError
 from .builtin_effects import Specular
 from .effect import Context, DepolarizedLobe, Effect
 from .geometry import Geometry
 from .parameter import Parameter
+from .plugin_guard import checking_outputs, culprit, effect_failure
 from .registry import registry
 
 
@@ -157,7 +158,24 @@ class Model:
         Missing parameters take their defaults.  Returns arrays of shape (N,) for scalar
         parameters or (P, N) for P parameter sets.  ``check=False`` skips the test for
         physically impossible values (for callers that already applied the priors).
+        A plug-in effect that raises or exits becomes one EffectError naming it.
         """
+        try:
+            return self._evaluate(params, geometry, mueller, check)
+        except SpacepolError:
+            raise
+        except (Exception, SystemExit) as exc:
+            effect = culprit(self.effects, exc)
+            if effect is None:
+                raise
+            raise effect_failure(effect, exc) from exc
+
+    def check_plugins(self, params: dict, geometry: Geometry) -> Prediction:
+        """Evaluate once with every plug-in hook's output checked for NaN/inf (an EffectError names it)."""
+        with checking_outputs(self.effects):
+            return self.evaluate(params, geometry, check=False)
+
+    def _evaluate(self, params, geometry, mueller, check) -> Prediction:
         values, batch = self._resolve(params, check)
         geo = geometry
         for e in self.effects:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import inspect
+import traceback
 from importlib.metadata import entry_points
 from pathlib import Path
 
@@ -23,7 +24,8 @@ class Registry:
         if not cls.name:
             raise SpacepolError(f"effect class {cls.__name__} has no 'name'")
         known = self._effects.get(cls.name)
-        if known is not None and known is not cls:
+        reloaded = known is not None and (known.__module__, known.__qualname__) == (cls.__module__, cls.__qualname__)
+        if known is not None and known is not cls and not reloaded:  # the same file loaded again replaces itself
             raise SpacepolError(f"effect name '{cls.name}' is already registered by {known.__module__}.{known.__name__}")
         self._effects[cls.name] = cls
         return cls
@@ -51,8 +53,14 @@ class Registry:
         module = importlib.util.module_from_spec(module_spec)
         try:
             module_spec.loader.exec_module(module)
+        except SystemExit as exc:
+            raise SpacepolError(f"--effect '{spec}': importing {path} called sys.exit({exc.code!r})") from None
         except Exception as exc:
-            raise SpacepolError(f"--effect '{spec}': importing {path} failed: {type(exc).__name__}: {exc}") from exc
+            here = path.resolve()
+            line = next((n for f, n in traceback.walk_tb(exc.__traceback__)
+                         if Path(f.f_code.co_filename).resolve() == here), None)
+            at = f" (line {line})" if line else ""
+            raise SpacepolError(f"--effect '{spec}': importing {path} failed{at}: {type(exc).__name__}: {exc}") from None
         if not hasattr(module, attr):
             raise SpacepolError(f"--effect '{spec}': {path} defines no '{attr}'")
         return self.register(getattr(module, attr))

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..infer.engines import OPTIMIZERS, optimize
+from ..infer.engines import OPTIMIZERS, check_method, optimize
 from ..infer.inversion import invert
 from ..infer.objective import PaperObjective
 from ..infer.prior_set import PriorSet
@@ -31,10 +31,11 @@ def run_comparison(posterior, data, out: Path, methods=None, seeds: int = 3, bas
                    progress: bool = True) -> dict:
     methods = methods or DEFAULT_METHODS
     for m in methods:
-        if m != "emcee" and m not in OPTIMIZERS and not m.startswith("nlopt:"):
-            from ..errors import UnknownNameError
+        check_method(m)
+    if len(set(methods)) != len(methods):
+        from ..errors import UnknownNameError
 
-            raise UnknownNameError(f"unknown method '{m}' (known: {', '.join(DEFAULT_METHODS)})")
+        raise UnknownNameError(f"--methods {' '.join(methods)}: a method is named twice")
     model = posterior.likelihood.model
     objective = PaperObjective(data, model, _model_priors(posterior))
     runs = []

@@ -24,7 +24,7 @@ def signature_figure(base, candidates, fig=None) -> Figure:
     for j, (name, sig) in enumerate(candidates):
         for i, o in enumerate(observables):
             ax = axes[i, j]
-            ax.scatter(x, sig[o]["observed"], s=9, c=data.theta_i, cmap="viridis", label="observed residual")
+            dots = ax.scatter(x, sig[o]["observed"], s=9, c=data.theta_i, cmap="viridis", label="observed residual")
             ax.scatter(x, sig[o]["signature"], s=14, marker="x", c="C3", lw=0.8, label=f"signature of {name}")
             ax.axhline(0, color="k", lw=0.6)
             ax.set_title(f"{name}: {o} (correlation {sig[o]['correlation']:+.2f})", fontsize=8)
@@ -33,39 +33,68 @@ def signature_figure(base, candidates, fig=None) -> Figure:
             if i == len(observables) - 1:
                 ax.set_xlabel("theta_r (deg), + specular side")
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle("Does the candidate change the prediction where the base model misses? (colour: theta_i)", fontsize=9)
+    if candidates:
+        fig.colorbar(dots, ax=axes.ravel().tolist(), label="theta_i (deg) of the observed residuals", shrink=0.8)
+    fig.suptitle("Observed residuals of the base model (dots) and each candidate's signature (crosses): "
+                 "where they agree, the candidate explains the misfit", fontsize=9)
     return fig
 
 
 def ladder_figure(rungs, fig=None) -> Figure:
-    """Top: DOP residual / noise against theta_r for every rung; bottom: RMSE, chi2_red, ELPD per rung."""
-    fig = fig or Figure(figsize=(3.2 * len(rungs) + 1, 6.0), layout="constrained")
+    """Top: residual / noise of the first observable against theta_r for every rung (colour: theta_i,
+    with its key); bottom: ELPD-LOO per rung and the error measure that applies: reduced chi^2 when the
+    file gives the noise, the inferred noise level per observable when it does not (then chi^2 is ~1
+    by construction and says nothing)."""
+    fig = fig or Figure(figsize=(3.2 * len(rungs) + 1.6, 6.4), layout="constrained")
     grid = fig.add_gridspec(2, len(rungs))
+    scatter = None
     for i, rung in enumerate(rungs):
         inv = rung["_inversion"]
         ax = fig.add_subplot(grid[0, i])
         obs = inv.posterior.likelihood.observables[0]
         z = standardised_residuals(inv.posterior, inv.result.flat_samples())[obs]
         data = inv.posterior.likelihood.data
-        ax.scatter(signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
+        scatter = ax.scatter(signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
         ax.axhline(0, color="k", lw=0.8)
         for level in (-2, 2):
             ax.axhline(level, color="k", lw=0.5, ls=":")
-        ax.set_title(rung["model"].replace("+", "\n+"), fontsize=7)
-        ax.set_xlabel("theta_r (deg)", fontsize=8)
+        ax.set_title(f"rung {i}: " + rung["model"].replace("+", "\n+"), fontsize=7)
+        ax.set_xlabel("theta_r (deg), + specular side", fontsize=8)
         if i == 0:
             ax.set_ylabel(f"{obs} residual / noise")
+    if scatter is not None:
+        fig.colorbar(scatter, ax=fig.axes[: len(rungs)], label="theta_i (deg)", shrink=0.8)
     ax = fig.add_subplot(grid[1, :])
     x = np.arange(len(rungs))
-    ax.plot(x, [r["chi2_red"] for r in rungs], "o-", label="reduced chi^2")
-    ax.axhline(1, color="k", lw=0.5, ls=":")
-    ax.set_yscale("log")
-    ax.set_xticks(x, [r["model"].split("+")[-1] if i else r["model"] for i, r in enumerate(rungs)], fontsize=8)
-    ax.set_ylabel("reduced chi^2")
+    labels = [r["model"] if i == 0 else "+ " + r["model"].split("+")[-1] for i, r in enumerate(rungs)]
+    ax.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s-", color="C1",
+                label="ELPD-LOO +- SE (higher is better)")
+    ax.set_ylabel("ELPD-LOO", color="C1")
+    ax.set_xticks(x, labels, fontsize=8)
+    noise = list(dict.fromkeys(k for r in rungs for k in r.get("inferred_noise", {})))
     ax2 = ax.twinx()
-    ax2.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s--", color="C1", label="ELPD-LOO")
-    ax2.set_ylabel("ELPD-LOO", color="C1")
-    ax.set_title("each rung adds one effect: the error falls towards the noise floor (chi^2 = 1)", fontsize=9)
+    if noise:
+        for j, name in enumerate(noise):
+            ax2.plot(x, [r["inferred_noise"].get(name, np.nan) for r in rungs], "o--", color=f"C{j}",
+                     label=f"inferred {name}")
+        ax2.set_ylabel("inferred noise level (the error the model leaves)")
+        what = "inferred noise"
+        first, last = rungs[0]["inferred_noise"], rungs[-1]["inferred_noise"]
+        change = ", ".join(f"{n} {first.get(n, np.nan):.3g} -> {last.get(n, np.nan):.3g}" for n in noise)
+    else:
+        ax2.plot(x, [r["chi2_red"] for r in rungs], "o--", color="C0", label="reduced chi^2 (known noise)")
+        ax2.axhline(1, color="k", lw=0.5, ls=":")
+        ax2.set_yscale("log")
+        ax2.set_ylabel("reduced chi^2 (1 = noise floor)")
+        what = "reduced chi^2"
+        change = f"chi^2_red {rungs[0]['chi2_red']:.3g} -> {rungs[-1]['chi2_red']:.3g}"
+    ax2.set_yscale("log")
+    handles = ax.get_legend_handles_labels()
+    handles2 = ax2.get_legend_handles_labels()
+    ax.legend(handles[0] + handles2[0], handles[1] + handles2[1], fontsize=7, loc="best")
+    delta = rungs[-1]["elpd_loo"] - rungs[0]["elpd_loo"]
+    ax.set_title(f"ELPD-LOO and {what} per rung: ELPD {rungs[0]['elpd_loo']:.1f} -> {rungs[-1]['elpd_loo']:.1f} "
+                 f"({delta:+.1f}); {change}", fontsize=9)
     return fig
 
 

@@ -10,13 +10,20 @@ from ..infer.inference_data import predictive_means
 
 
 def corner_figure(result, truths: dict | None = None, fig=None) -> Figure:
+    """Corner plot with 5/50/95 % quantiles; three ticks per axis so the labels do not collide."""
     flat = result.flat_samples()
-    fig = fig or Figure(figsize=(2.0 * len(result.names) + 1, 2.0 * len(result.names) + 1))
+    size = 2.2 * len(result.names) + 1.2
+    fig = fig or Figure(figsize=(size, size))
     truth_values = None
     if truths:
         truth_values = [truths.get(n) for n in result.names]
     corner.corner(flat, labels=result.names, quantiles=[0.05, 0.5, 0.95], show_titles=True,
-                  title_fmt=".3g", truths=truth_values, truth_color="C3", fig=fig)
+                  title_fmt=".3g", truths=truth_values, truth_color="C3", fig=fig, max_n_ticks=3,
+                  labelpad=0.12, title_kwargs={"fontsize": 9}, label_kwargs={"fontsize": 10})
+    for ax in fig.axes:
+        ax.tick_params(labelsize=7)
+    fig.suptitle("Posterior: marginals (5, 50, 95 % lines) and pairwise densities" +
+                 ("; truths in red" if truth_values else ""), fontsize=10, y=1.0)
     return fig
 
 
@@ -32,35 +39,62 @@ def signed_theta_r(data, idx=slice(None)):
     return np.where(forward, data.theta_r[idx], -data.theta_r[idx])
 
 
-def fit_figure(posterior, result, observable: str = "dop", max_draws: int = 2000, rng=None, fig=None) -> Figure:
-    """Data, posterior-median prediction and its 90 % band against theta_r, one panel per theta_i."""
+_AXIS_LABEL = {"dop": "DOP", "brdf": "BRDF (sr^-1)", "q": "q = S1/S0", "u": "u = S2/S0"}
+
+
+def _in_plane(data, idx):
+    return np.abs(np.sin(np.radians(data.dphi[idx]))) < 1e-6
+
+
+def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=None, fig=None,
+               max_panels: int = 8) -> Figure:
+    """Data with the posterior-median prediction and its 90 % band against theta_r: one row per
+    fitted observable, one column per incidence angle (at most ``max_panels``, evenly chosen).
+    In-plane sweeps are drawn as curves; out-of-plane points (other azimuths at the same theta_r)
+    as separate bars, since joining them in theta_r order would draw a sawtooth."""
     data = posterior.likelihood.data
+    observables = list(observables or posterior.likelihood.observables)
     flat = result.flat_samples()
     rng = rng or np.random.default_rng(0)
     if len(flat) > max_draws:
         flat = flat[rng.choice(len(flat), max_draws, replace=False)]
-    means = predictive_means(posterior, flat)[observable]
-    lo, med, hi = np.percentile(means, [5, 50, 95], axis=0)
+    means = predictive_means(posterior, flat)
     panels = _panels(data)
-    cols = min(4, len(panels))
-    rows = int(np.ceil(len(panels) / cols))
-    fig = fig or Figure(figsize=(3.6 * cols, 2.9 * rows), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
-    y = getattr(data, observable)
-    err = getattr(data, f"{observable}_err")
-    for ax, (ti, idx) in zip(axes, panels):
-        x = signed_theta_r(data, idx)
-        order = np.argsort(x)
-        ax.fill_between(x[order], lo[idx][order], hi[idx][order], color="C0", alpha=0.3, lw=0, label="90 % band")
-        ax.plot(x[order], med[idx][order], "-", color="C0", lw=1.2, label="posterior median")
-        ax.errorbar(x, y[idx], yerr=None if err is None else err[idx], fmt="o", ms=3, color="k", lw=0.8, label="data")
-        ax.set_title(f"theta_i = {ti:g} deg", fontsize=9)
-        ax.set_xlabel("theta_r (deg, < 0: dphi != 180)", fontsize=8)
-        ax.set_ylabel({"dop": "DOP", "brdf": "BRDF (sr^-1)", "q": "q = S1/S0", "u": "u = S2/S0"}[observable], fontsize=8)
-        ax.grid(alpha=0.3)
-    for ax in axes[len(panels):]:
-        ax.set_visible(False)
-    axes[0].legend(fontsize=7)
+    if len(panels) > max_panels:
+        panels = [panels[i] for i in np.unique(np.linspace(0, len(panels) - 1, max_panels).round().astype(int))]
+    cols = len(panels)
+    fig = fig or Figure(figsize=(3.2 * cols + 0.5, 2.8 * len(observables)), layout="constrained")
+    axes = fig.subplots(len(observables), cols, squeeze=False)
+    for row, observable in enumerate(observables):
+        lo, med, hi = np.percentile(means[observable], [5, 50, 95], axis=0)
+        y = getattr(data, observable)
+        err = getattr(data, f"{observable}_err", None)
+        for ax, (ti, idx) in zip(axes[row], panels):
+            x = signed_theta_r(data, idx)
+            plane = _in_plane(data, idx)
+            if plane.any():
+                order = np.argsort(x[plane])
+                xi = x[plane][order]
+                ax.fill_between(xi, lo[idx][plane][order], hi[idx][plane][order], color="C0", alpha=0.3, lw=0,
+                                label="90 % band (in plane)")
+                ax.plot(xi, med[idx][plane][order], "-", color="C0", lw=1.2, label="posterior median")
+            off = ~plane
+            if off.any():
+                ax.vlines(x[off], lo[idx][off], hi[idx][off], color="C1", lw=2, alpha=0.5, label="90 % band (out of plane)")
+                ax.plot(x[off], med[idx][off], "_", color="C1", ms=6)
+            ax.errorbar(x, y[idx], yerr=None if err is None else err[idx], fmt="o", ms=2.5, color="k", lw=0.8, label="data")
+            if observable == "brdf" and np.all(y[idx] > 0):
+                ax.set_yscale("log")
+            if row == 0:
+                ax.set_title(f"theta_i = {ti:g} deg", fontsize=9)
+            if row == len(observables) - 1:
+                ax.set_xlabel("theta_r (deg; < 0: source side)", fontsize=8)
+            ax.set_ylabel(_AXIS_LABEL.get(observable, observable), fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=6)
+    fig.suptitle("Measured data (black) against the model: posterior median and 90 % band of the noise-free prediction",
+                 fontsize=9)
     return fig
 
 
@@ -81,7 +115,9 @@ def residual_figure(posterior, result, fig=None) -> Figure:
         for level in (-2, 2):
             ax.axhline(level, color="k", lw=0.5, ls=":")
         ax.set_ylabel(f"{o} residual / noise")
-        ax.set_xlabel("theta_r (deg, < 0: dphi != 180)")
+        ax.set_xlabel("theta_r (deg; < 0: source side)")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7, ncol=4)
+    axes[0].set_title("Standardised residuals (data - posterior-median prediction) / noise; noise alone stays within +-2",
+                      fontsize=9)
     return fig

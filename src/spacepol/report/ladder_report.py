@@ -9,10 +9,18 @@ from .criticism_figures import ladder_figure
 
 
 def ladder_table(public: list[dict]) -> list[str]:
-    lines = ["| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO | R-hat max |", "|---|---|---|---|---|---|"]
+    noise = list(dict.fromkeys(k for r in public for k in r.get("inferred_noise", {})))
+    head = "| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO |" + "".join(f" {n} (inferred) |" for n in noise) + " R-hat max |"
+    lines = [head, "|" + "---|" * (6 + len(noise))]
     for i, r in enumerate(public):
         rmse = "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}"
-        lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} | {r['rhat_max']:.3f} |")
+        cells = "".join(f" {r['inferred_noise'].get(n, float('nan')):.4g} |" for n in noise)
+        lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} |"
+                     f"{cells} {r['rhat_max']:.3f} |")
+    if noise:
+        lines.append("")
+        lines.append("The noise is inferred (the file gives no errors), so reduced chi^2 is ~1 at every rung by construction; "
+                     "the error that falls is the inferred noise level, and ELPD-LOO (higher is better) ranks the rungs.")
     return lines
 
 

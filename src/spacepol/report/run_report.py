@@ -7,10 +7,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_path, save_figure, write_json
+from ..infer.inference_data import for_storage
+from ..io.atomic import atomic_path, save_figure, write_json, write_text
 from . import html as H
 from ..criticism.residuals import analyse
 from .criticism_figures import residual_trends_figure
+from ..infer.identifiability import bound_finding
 from .inversion_figures import corner_figure, fit_figure, residual_figure
 
 
@@ -56,16 +58,16 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
     truths = truths_from_metadata(posterior.likelihood.data.metadata)
     figures = {
         "corner.png": corner_figure(result, truths),
-        "fit.png": fit_figure(posterior, result, posterior.likelihood.observables[0]),
+        "fit.png": fit_figure(posterior, result),
         "residuals.png": residual_figure(posterior, result),
         "residual_trends.png": residual_trends_figure(analyse(posterior, result.flat_samples())),
     }
     for name, fig in figures.items():
         save_figure(fig, out / name)
     with atomic_path(out / "posterior.nc") as tmp:
-        inv.idata.to_netcdf(str(tmp))
+        for_storage(inv.idata).to_netcdf(str(tmp))
     write_json(out / "summary.json", summary)
-    (out / "report.html").write_text(_html(inv, data_path, figures, truths, notes or []), encoding="utf-8")
+    write_text(out / "report.html", _html(inv, data_path, figures, truths, notes or []))
     return summary
 
 
@@ -75,7 +77,8 @@ def _html(inv, data_path, figures, truths, notes) -> str:
     rows = []
     for name, q in s["parameters"].items():
         truth = truths.get(name)
-        rows.append([name, f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
+        flagged = any(f["parameter"] == name for f in s["identifiability"].get("at_bound", []))
+        rows.append([name + (" (at a bound)" if flagged else ""), f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
                      f"{diag['per_parameter'][name]['rhat']:.4f}", f"{diag['per_parameter'][name]['ess_bulk']:.0f}",
                      "" if truth is None else f"{truth:.4g}", s["priors"].get(name, "")])
     converged = diag["rhat_max"] <= 1.01 and diag["ess_min"] >= 400 and not s["sampler"].get("capped")
@@ -87,7 +90,8 @@ def _html(inv, data_path, figures, truths, notes) -> str:
         ("Data and model", H.paragraph(
             f"{data_path}: {s['n_observations']} observations ({', '.join(s['observables'])}); model {s['model']}; "
             f"seed {s['seed']}; {s['seconds']:.1f} s.")),
-        ("Parameters", H.table(["parameter", "median", "90 % interval", "68 % interval", "R-hat", "ESS bulk", "truth", "prior"], rows)),
+        ("Parameters", H.table(["parameter", "median", "90 % interval", "68 % interval", "R-hat", "ESS bulk", "truth", "prior"], rows)
+         + (H.bullets([bound_finding(f) for f in s["identifiability"].get("at_bound", [])]))),
         ("Convergence", H.paragraph(verdict) + H.table(
             ["R-hat max", "ESS min (bulk/tail)", "tau max (steps)", "acceptance", "walkers", "steps", "burn-in", "thin"],
             [[f"{diag['rhat_max']:.4f}", f"{diag['ess_min']:.0f}", f"{diag['tau_max']:.1f}", f"{diag['acceptance']:.2f}",
@@ -98,7 +102,8 @@ def _html(inv, data_path, figures, truths, notes) -> str:
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
                         + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
          + H.bullets(s["residual_structure"]["findings"])
-         + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction.")
+         + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction, "
+                   "per observable (rows) and incidence angle (columns).")
          + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")
          + H.image(H.figure_to_data_uri(figures["residual_trends.png"]),
                    "Residuals against each angle and the DOP level, with Spearman's rho (red: p < 0.01).")),

@@ -109,13 +109,21 @@ def contrast_histograms(draws: dict, fig=None) -> Figure:
         for j, q in enumerate(quantities):
             ax = axes[i, j]
             v = np.asarray(values[q], float)
-            ax.hist(v, bins=60, color="C0", alpha=0.8)
-            for p in np.percentile(v, [5, 50, 95]):
-                ax.axvline(p, color="k", lw=0.8, ls="--")
+            v = v[np.isfinite(v)]
+            if v.size and np.ptp(v) <= 1e-9 * max(1.0, abs(float(np.median(v)))):
+                # a single spike would look like a plotting error: say why there is no spread
+                ax.axvline(v[0], color="C0", lw=3)
+                ax.text(0.5, 0.5, f"every draw gives {v[0]:.4g}:\nno input uncertainty\nreaches this quantity",
+                        transform=ax.transAxes, ha="center", va="center", fontsize=7,
+                        bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+            elif v.size:
+                ax.hist(v, bins=60, color="C0", alpha=0.8)
+                for p in np.percentile(v, [5, 50, 95]):
+                    ax.axvline(p, color="k", lw=0.8, ls="--")
             ax.set_yticks([])
             if i == 0:
                 ax.set_title(q.replace("_", " "), fontsize=8)
             if j == 0:
                 ax.set_ylabel(case, fontsize=7)
-    fig.suptitle("Table 3 as distributions (dashed: 5, 50, 95 %)", fontsize=9)
+    fig.suptitle("Table 3 as distributions over posterior, geometry and sky draws (dashed: 5, 50, 95 %)", fontsize=9)
     return fig

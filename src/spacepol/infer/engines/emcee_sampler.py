@@ -24,19 +24,11 @@ from __future__ import annotations
 
 import sys
 import time
-from pathlib import Path
 
 import emcee
 import numpy as np
 
 from ..result import Result
-
-
-def _has_chain(path) -> bool:
-    import h5py
-
-    with h5py.File(path, "r") as f:
-        return "mcmc" in f
 
 
 def default_walkers(ndim: int) -> int:
@@ -87,31 +79,65 @@ def _moves():
     return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
 
 
+def _tau_at(sampler, iteration: int) -> np.ndarray:
+    """The integrated autocorrelation time of the first ``iteration`` steps (what an uninterrupted run
+    computed when it stood there), so a resumed run takes the same decisions."""
+    chain = sampler.get_chain()[:iteration]
+    return emcee.autocorr.integrated_time(chain, tol=0)
+
+
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
                  tau_multiple: float = 50.0, check_every: int = 500, min_steps: int = 1000,
                  backend_path=None, progress: bool = True, model_name: str = "", seed: int | None = None,
                  initial=None, rhat_target: float = 1.01, ess_target: float = 400.0) -> Result:
+    from ..chain_file import chain_iterations
+
     start = time.perf_counter()
     ndim = posterior.ndim
     walkers = walkers or default_walkers(ndim)
     backend = None
     resumed = False
     if backend_path is not None:
+        stored = chain_iterations(backend_path)  # ChainFileError (one line, the remedy) if damaged
         backend = emcee.backends.HDFBackend(str(backend_path), name="mcmc")
-        if Path(backend_path).exists() and _has_chain(backend_path) and backend.iteration > 0:
-            if backend.shape != (walkers, ndim):
+        if stored > 0:
+            if tuple(backend.shape) != (walkers, ndim):
                 from ...errors import SpacepolError
 
-                raise SpacepolError(f"{backend_path}: holds a chain of shape {backend.shape}, this run needs {(walkers, ndim)}; use another --out")
+                raise SpacepolError(f"{backend_path}: holds a chain of shape {tuple(map(int, backend.shape))}, this run "
+                                    f"needs {(walkers, ndim)}; use another --out or --restart")
             resumed = True
         else:
             backend.reset(walkers, ndim)
 
     sampler = emcee.EnsembleSampler(walkers, ndim, posterior.log_prob, vectorize=True, moves=_moves(), backend=backend)
+    tau, previous_tau, capped = np.full(ndim, np.inf), None, True
+
+    def converged(tau, previous_tau):
+        settled = previous_tau is not None and np.all(np.abs(previous_tau - tau) < 0.05 * tau)
+        long_enough = sampler.iteration >= max(min_steps, tau_multiple * np.max(tau)) and settled
+        rhat, ess = (_rhat_ess(sampler, tau) if long_enough else (np.nan, np.nan))
+        return long_enough and rhat <= rhat_target and ess >= ess_target, long_enough, rhat, ess
+
     if resumed:
         state = None
-        if progress:
-            print(f"  resuming the chain in {backend_path} at step {backend.iteration}", file=sys.stderr)
+        done = sampler.iteration
+        at_check = done % check_every == 0 or done >= max_steps
+        before = (done - check_every if done % check_every == 0 else done // check_every * check_every) if at_check \
+            else done // check_every * check_every  # the check whose tau an uninterrupted run holds next
+        previous_tau = _tau_at(sampler, before) if before >= check_every else None
+        if at_check:  # stopped right at a check: take that check's decision again
+            tau = _tau_at(sampler, done)
+            ok, *_ = converged(tau, previous_tau)
+            if ok or done >= max_steps:
+                capped = not ok
+                if progress:
+                    print(f"  the chain in {backend_path} is complete ({done} steps, "
+                          f"{'converged' if ok else 'at the step cap'}); writing the report", file=sys.stderr)
+                max_steps = done  # no further steps
+            previous_tau = tau
+        if progress and done < max_steps:
+            print(f"  resuming the chain in {backend_path} at step {done}", file=sys.stderr)
     else:
         sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
         if initial is None:
@@ -120,23 +146,22 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             initial = posterior.priors.sample(rng, walkers)
         state = initial
 
-    tau, previous_tau, capped = np.full(ndim, np.inf), None, True
     while sampler.iteration < max_steps:
         target = min(max_steps, (sampler.iteration // check_every + 1) * check_every)
         state = sampler.run_mcmc(state, target - sampler.iteration, progress=False)
         tau = sampler.get_autocorr_time(tol=0)
-        settled = previous_tau is not None and np.all(np.abs(previous_tau - tau) < 0.05 * tau)
+        ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau
-        long_enough = sampler.iteration >= max(min_steps, tau_multiple * np.max(tau)) and settled
-        rhat, ess = (_rhat_ess(sampler, tau) if long_enough else (np.nan, np.nan))
         if progress:
             extra = f", R-hat {rhat:.3f}, ESS {ess:.0f}" if long_enough else ""
             print(f"  step {sampler.iteration:6d}/{max_steps}: tau_max {np.max(tau):7.1f} "
                   f"(need {tau_multiple:.0f} tau = {tau_multiple * np.max(tau):7.0f} steps), "
                   f"acceptance {np.mean(sampler.acceptance_fraction):.2f}{extra}", file=sys.stderr)
-        if long_enough and rhat <= rhat_target and ess >= ess_target:
+        if ok:
             capped = False
             break
+    if not np.all(np.isfinite(tau)):  # no block was run here (a finished chain): measure what is stored
+        tau = _tau_at(sampler, sampler.iteration)
 
     tau_max = float(np.max(tau))
     burn, thin = _kept(sampler, tau)

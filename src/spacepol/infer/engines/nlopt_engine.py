@@ -13,11 +13,17 @@ from ..result import History, Result
 NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
 
 
+def check_algorithm(algorithm: str) -> int:
+    """nlopt's code for a global algorithm name; UnknownNameError otherwise."""
+    code = getattr(nlopt, algorithm, None) if algorithm.isidentifier() else None
+    if not isinstance(code, int) or not algorithm.startswith("G"):
+        raise UnknownNameError(f"unknown nlopt global algorithm '{algorithm}' (try {', '.join(NLOPT_ALGORITHMS)})")
+    return code
+
+
 def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: str = "",
               max_evaluations: int = 20000, ftol_rel: float = 1e-10, seed: int | None = None) -> Result:
-    code = getattr(nlopt, algorithm, None)
-    if code is None or not algorithm.startswith("G"):
-        raise UnknownNameError(f"unknown nlopt global algorithm '{algorithm}' (try {', '.join(NLOPT_ALGORITHMS)})")
+    code = check_algorithm(algorithm)
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim
     history = History()

@@ -38,7 +38,11 @@ def expect_error(capsys, folder, args, *words):
 
 @pytest.fixture
 def here(tmp_path, monkeypatch):
+    """A working folder with a good data file and a plain file; plug-ins registered here are forgotten after."""
+    from spacepol.physics.registry import registry
+
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(registry, "_effects", dict(registry._effects))
     (tmp_path / "good.csv").write_text(GOOD_CSV)
     (tmp_path / "a_file").write_text("x")
     return tmp_path

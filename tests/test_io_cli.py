@@ -89,7 +89,7 @@ def test_cli_bad_file_exit_2_one_line_no_output(tmp_path, case):
     (["--set", "n"], "expected NAME=VALUE"),
     (["--set", "n=abc"], "'abc' is not a number"),
     (["--model", "specular+smith+shadowing"], "replaces 'shadowing'"),
-    (["--noise-dop", "-1"], "noise levels must be >= 0"),
+    (["--noise-dop", "-1"], "argument --noise-dop: -1: must be >= 0"),
 ])
 def test_cli_bad_arguments(tmp_path, args, message):
     out = tmp_path / "o.csv"

@@ -65,18 +65,20 @@ def test_run_explains_the_dop_only_degeneracy(tmp_path):
     assert s["sampler"]["capped"] and "hit the step cap" in html
 
 
-def test_rerun_resumes_the_chain(run_out):
-    """A second run with the same --out continues the stored chain instead of starting over."""
+def test_rerun_of_a_finished_run_reports_again_and_a_different_run_is_refused(run_out):
+    """The same command on a finished run: no new steps, the report written again, exit 0 (resuming an
+    interrupted chain is tested with real kills in test_recovery.py); a different run on that folder
+    is refused with the remedy."""
     import emcee
 
     before = emcee.backends.HDFBackend(str(run_out / "chain.h5"), name="mcmc", read_only=True).iteration
     data = run_out.parent / "al.csv"
     run = cli("run", data, "--model", "specular+smith", "--seed", "1", "--out", run_out)
-    assert run.returncode == 0 and "resuming the chain" in run.stderr
+    assert run.returncode == 0 and "is complete" in run.stderr, run.stderr
     after = emcee.backends.HDFBackend(str(run_out / "chain.h5"), name="mcmc", read_only=True).iteration
-    assert after > before
+    assert after == before
     clash = cli("run", data, "--model", "specular+smith", "--seed", "2", "--quiet", "--out", run_out)
-    assert clash.returncode == 2 and "holds the chain of a different run" in clash.stderr
+    assert clash.returncode == 2 and "holds the chain of a different run" in clash.stderr and "--restart" in clash.stderr
 
 
 def test_ptfe_run_converges_and_explains_the_index(tmp_path):

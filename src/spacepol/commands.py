@@ -199,12 +199,12 @@ def run(args) -> int:
     check_walkers(args.walkers, posterior.ndim)
     if not args.restart:
         check_resumable(out / "chain.h5", posterior, args.walkers, args.seed)
-    if not args.quiet:
-        print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
-              f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}", file=sys.stderr)
     made_folder = not out.exists()
     chain = out / "chain.h5"
     with folder_lock(out):
+        if not args.quiet:
+            print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
+                  f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}", file=sys.stderr)
         if args.restart and (old := set_aside(chain)) is not None and not args.quiet:
             print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
         fresh = not chain.exists()

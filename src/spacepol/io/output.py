@@ -59,9 +59,10 @@ def check_output_dir(path, option: str = "--out") -> Path:
 
 def check_output_file(path, option: str = "--out") -> Path:
     """A file path whose folder exists or can be made and is writable, and that is not a folder."""
+    text = str(path)
+    if text.strip() == "" or text.endswith(("/", os.sep)):
+        raise OutputPathError(f"{option} {text}: give a file name, not a folder")
     path = Path(path)
-    if str(path).strip() == "" or str(path).endswith(os.sep):
-        raise OutputPathError(f"{option} {path}: give a file name, not a folder")
     if path.is_dir():
         raise OutputPathError(f"{option} {path}: is a folder; give a file name")
     if path.exists() and not os.access(path, os.W_OK):

@@ -1,0 +1,127 @@
+"""Runs that recover: kill -9 during sampling and during the report, then the same command completes;
+a finished run re-run exits 0; a truncated chain.h5 gives one line and --restart works; two runs on
+one folder give one clear error.  Real processes and real signals (the in-process resume test that
+proves bit-identity is in test_sampler.py)."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+
+def cli(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "spacepol.cli", *map(str, args)], capture_output=True, text=True, env=ENV, **kw)
+
+
+def start(*args):
+    return subprocess.Popen([sys.executable, "-m", "spacepol.cli", *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, env=ENV)
+
+
+def wait_for(proc, text, timeout=240):
+    """Read the process's output until a line contains ``text``; returns the lines read."""
+    lines, deadline = [], time.time() + timeout
+    while time.time() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        lines.append(line)
+        if text in line:
+            return lines
+    proc.kill()
+    raise AssertionError(f"never saw {text!r}: {''.join(lines)}")
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("recovery")
+    path = tmp / "syn.csv"
+    r = cli("synth", "--model", "specular+smith", "--set", "n=1.5", "--set", "k=0.5", "--set", "sigma=0.2", "--set", "ks=0.8",
+            "--noise-dop", "0.01", "--noise-brdf", "0.05", "--seed", "3", "--out", path)
+    assert r.returncode == 0, r.stderr
+    return path
+
+
+RUN = ("--model", "specular+smith", "--steps", "1500", "--seed", "2")
+
+
+def test_kill_during_sampling_and_during_the_report_then_the_same_command_completes(data, tmp_path):
+    out = tmp_path / "run"
+    proc = start("run", data, *RUN, "--out", out)
+    wait_for(proc, "step    500/")
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert (out / "chain.h5").exists() and not (out / "summary.json").exists()
+
+    proc = start("run", data, *RUN, "--out", out)
+    lines = wait_for(proc, "writing the report")
+    assert any("resuming the chain" in line and "step 500" in line for line in lines), lines
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+
+    again = cli("run", data, *RUN, "--out", out)
+    assert again.returncode == 0, again.stderr
+    assert "is complete (1500 steps" in again.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["sampler"]["steps"] == 1500
+    assert not list(out.glob(".*.tmp")), "a half-written file was left behind"
+
+    finished = cli("run", data, *RUN, "--out", out)  # a finished run re-run: reports again, exit 0
+    assert finished.returncode == 0, finished.stderr
+    assert "is complete" in finished.stderr
+    assert json.loads((out / "summary.json").read_text())["parameters"] == summary["parameters"]
+
+
+def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path):
+    out = tmp_path / "run"
+    first = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    assert first.returncode == 0, first.stderr
+    chain = out / "chain.h5"
+    size = chain.stat().st_size
+    with open(chain, "r+b") as fh:  # a kill during a write / a full disk: the file is cut short
+        fh.truncate(size // 3)
+    damaged = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    assert damaged.returncode == 2
+    lines = damaged.stderr.strip().splitlines()
+    assert len(lines) == 1 and "damaged chain file" in lines[0] and "--restart" in lines[0], damaged.stderr
+    assert "Traceback" not in damaged.stderr
+
+    restarted = cli("run", data, *RUN, "--steps", "500", "--quiet", "--restart", "--out", out)
+    assert restarted.returncode == 0, restarted.stderr
+    assert (out / "chain.h5.old").stat().st_size == size // 3  # the old file kept aside
+    assert json.loads((out / "summary.json").read_text())["sampler"]["steps"] == 500
+
+    chain.write_bytes(b"")  # an empty file
+    empty = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    assert empty.returncode == 2 and "empty file" in empty.stderr
+
+
+def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
+    out = tmp_path / "run"
+    proc = start("run", data, *RUN, "--steps", "20000", "--out", out)
+    try:
+        wait_for(proc, "step    500/")
+        second = cli("run", data, *RUN, "--out", out)
+        assert second.returncode == 2
+        lines = second.stderr.strip().splitlines()
+        assert len(lines) == 1 and "in use by another" in lines[0], second.stderr
+    finally:
+        proc.kill()
+        proc.wait()
+    # the killed run held the lock only while alive: the same command continues now
+    third = cli("run", data, *RUN, "--quiet", "--out", out)
+    assert third.returncode == 0, third.stderr
+
+
+def test_a_failed_run_leaves_nothing_that_blocks_the_corrected_command(data, tmp_path):
+    out = tmp_path / "run"
+    bad = cli("run", data, *RUN, "--walkers", "3", "--out", out)
+    assert bad.returncode == 2 and not out.exists()
+    good = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    assert good.returncode == 0, good.stderr

@@ -10,7 +10,6 @@ The fast in-process version of the same categories is tests/test_bad_input.py.
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 import tempfile

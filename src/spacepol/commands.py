@@ -374,6 +374,7 @@ def sky(args) -> int:
         "site": {"lat_deg": args.lat, "lon_deg": args.lon, "time": args.time},
         "model": {"name": model.name, "p_max": model.p_max} | ({"delta_deg": model.delta_deg} if args.model != "rayleigh" else {}),
         "aop_frame": "angle of the E-vector from the local meridian (towards the zenith), positive towards increasing azimuth",
+        "sun_below_horizon": bool(sun.zenith_deg > 90),
         "directions": [{"zenith_deg": z, "azimuth_deg": a, "dop": float(model.dop(z, a, s)), "aop_deg": float(model.aop(z, a, s))}
                        for z, a in directions],
         "projections": {name: {"zenith_30_cap_share_of_map": cap_fraction(p, 30.0),
@@ -389,6 +390,9 @@ def sky(args) -> int:
     save_figure(projection_distortion_figure(), out / "projections.png")
     write_json(out / "sky.json", report)
     print(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg east of north ({sun.time_utc})")
+    if sun.zenith_deg > 90:
+        print(f"note: the sun is {sun.zenith_deg - 90:.1f} deg below the horizon: there is no daylight sky then; the maps "
+              f"show the single-scattering pattern for reference only")
     for d in report["directions"]:
         print(f"  zenith {d['zenith_deg']:g}, azimuth {d['azimuth_deg']:g}: DOP {d['dop']:.3f}, AoP {d['aop_deg']:.1f} deg")
     print(f"wrote {out}/sky.json, sky_maps.png, projections.png")

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
+from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit, standardise
 from ..infer.inversion import invert
 from ..infer.optimum import find_optimum
@@ -278,5 +279,6 @@ def _explain(c, base) -> str:
                   else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
                    f"correlates {s['correlation']:+.2f} with the residuals and {change}")
+    bounds = [bound_finding(f) for f in c["inversion"].summary["identifiability"].get("at_bound", [])]
     return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
-            f"{rmse}" + "; ".join(why) + ".")
+            f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))

@@ -35,6 +35,7 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
                       "inferred_noise": inferred_noise(inv), "noise_known": not inferred_noise(inv),
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"], "parameters": inv.summary["parameters"],
+                      "at_bound": inv.summary["identifiability"].get("at_bound", []),
                       "_inversion": inv})
     return rungs
 

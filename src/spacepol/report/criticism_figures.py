@@ -67,17 +67,17 @@ def ladder_figure(rungs, fig=None) -> Figure:
     ax = fig.add_subplot(grid[1, :])
     x = np.arange(len(rungs))
     labels = [r["model"] if i == 0 else "+ " + r["model"].split("+")[-1] for i, r in enumerate(rungs)]
-    ax.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s-", color="C1",
+    ax.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s-", color="k",
                 label="ELPD-LOO +- SE (higher is better)")
-    ax.set_ylabel("ELPD-LOO", color="C1")
+    ax.set_ylabel("ELPD-LOO (solid)")
     ax.set_xticks(x, labels, fontsize=8)
     noise = list(dict.fromkeys(k for r in rungs for k in r.get("inferred_noise", {})))
     ax2 = ax.twinx()
     if noise:
         for j, name in enumerate(noise):
-            ax2.plot(x, [r["inferred_noise"].get(name, np.nan) for r in rungs], "o--", color=f"C{j}",
+            ax2.plot(x, [r["inferred_noise"].get(name, np.nan) for r in rungs], "o--", color=("C0", "C2", "C3", "C4")[j % 4],
                      label=f"inferred {name}")
-        ax2.set_ylabel("inferred noise level (the error the model leaves)")
+        ax2.set_ylabel("inferred noise (dashed): the error left")
         what = "inferred noise"
         first, last = rungs[0]["inferred_noise"], rungs[-1]["inferred_noise"]
         change = ", ".join(f"{n} {first.get(n, np.nan):.3g} -> {last.get(n, np.nan):.3g}" for n in noise)
@@ -85,7 +85,7 @@ def ladder_figure(rungs, fig=None) -> Figure:
         ax2.plot(x, [r["chi2_red"] for r in rungs], "o--", color="C0", label="reduced chi^2 (known noise)")
         ax2.axhline(1, color="k", lw=0.5, ls=":")
         ax2.set_yscale("log")
-        ax2.set_ylabel("reduced chi^2 (1 = noise floor)")
+        ax2.set_ylabel("reduced chi^2 (dashed; 1 = noise floor)")
         what = "reduced chi^2"
         change = f"chi^2_red {rungs[0]['chi2_red']:.3g} -> {rungs[-1]['chi2_red']:.3g}"
     ax2.set_yscale("log")

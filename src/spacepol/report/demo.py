@@ -20,6 +20,7 @@ import numpy as np
 
 from ..criticism.diagnose import diagnose
 from ..criticism.ladder import climb
+from ..infer.identifiability import bound_finding
 from ..infer.inversion import invert
 from ..io.atomic import write_json, write_text
 from ..infer.posterior import Posterior
@@ -105,8 +106,9 @@ def _criticism_section(report, rungs, folder: str) -> str:
         rows = [[r["model"], "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}", f"{r['chi2_red']:.2f}",
                  f"{r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f}"] for r in public]
         caption = "The ladder: residuals per rung (top); ELPD-LOO and reduced chi^2 per rung (bottom)."
+    flags = [f"{r['model']}: {bound_finding(f)}" for r in public for f in r.get("at_bound", [])]
     return (H.paragraph(f"verdict: {report['verdict']}. {report['conclusion']}") + H.paragraph(significance_statement(report))
-            + H.table(head, rows)
+            + H.table(head, rows) + (H.bullets(flags) if flags else "")
             + H.image(H.png_file_to_data_uri(Path(folder) / "ladder" / "ladder.png"), caption)
             + H.image(H.png_file_to_data_uri(Path(folder) / "diagnose" / "signatures.png"),
                       "Residuals of the base fit (dots) and each candidate's signature (crosses).")

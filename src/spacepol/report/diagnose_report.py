@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..infer.diagnostics import describe_fit
+from ..infer.identifiability import bound_finding
 from ..io.atomic import atomic_path, save_figure
 from . import html as H
 from ..criticism.residuals import analyse
@@ -62,7 +63,8 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
         ("Data and base model", H.paragraph(
             f"{data_label}; base model {report['model']}: RMSE(DOP) {fit['rmse_dop'] if fit['rmse_dop'] is None else round(fit['rmse_dop'], 5)}, "
             f"{describe_fit(base.summary)}, ELPD-LOO {fit['elpd_loo']:.1f} +- {fit['elpd_loo_se']:.1f}.")
-         + H.bullets(report["residual_structure"] + pareto_warnings(base.summary))),
+         + H.bullets(report["residual_structure"] + pareto_warnings(base.summary)
+                     + [bound_finding(f) for f in base.summary["identifiability"].get("at_bound", [])])),
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
         ("Ranking", H.table(["effect", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
                              "significant (> 2 SE and > 4)"], ranking_rows(report))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..infer.identifiability import bound_finding
 from ..io.atomic import atomic_path, save_figure, write_json
 from .criticism_figures import ladder_figure
 
@@ -17,6 +18,10 @@ def ladder_table(public: list[dict]) -> list[str]:
         cells = "".join(f" {r['inferred_noise'].get(n, float('nan')):.4g} |" for n in noise)
         lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} |"
                      f"{cells} {r['rhat_max']:.3f} |")
+    flags = [f"rung {i}: {bound_finding(f)}" for i, r in enumerate(public) for f in r.get("at_bound", [])]
+    if flags:
+        lines.append("")
+        lines.extend(flags)
     if noise:
         lines.append("")
         lines.append("The noise is inferred (the file gives no errors), so reduced chi^2 is ~1 at every rung by construction; "

@@ -104,19 +104,22 @@ def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path
 
 def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
     out = tmp_path / "run"
-    proc = start("run", data, *RUN, "--steps", "20000", "--out", out)
+    slow = ("--model", "paper", "--observables", "dop", "--seed", "2")  # the k_s/rho_d ridge: thousands of steps
+    proc = start("run", data, *slow, "--steps", "20000", "--out", out)
     try:
         wait_for(proc, "step    500/")
-        second = cli("run", data, *RUN, "--out", out)
+        second = cli("run", data, *slow, "--steps", "20000", "--out", out)
+        assert proc.poll() is None, "the first run ended too soon for this test"
         assert second.returncode == 2
         lines = second.stderr.strip().splitlines()
         assert len(lines) == 1 and "in use by another" in lines[0], second.stderr
     finally:
         proc.kill()
         proc.wait()
-    # the killed run held the lock only while alive: the same command continues now
-    third = cli("run", data, *RUN, "--quiet", "--out", out)
+    # the killed run held the lock only while it lived: the same command (capped here) continues the chain
+    third = cli("run", data, *slow, "--steps", "1000", "--out", out)
     assert third.returncode == 0, third.stderr
+    assert "resuming the chain" in third.stderr
 
 
 def test_a_failed_run_leaves_nothing_that_blocks_the_corrected_command(data, tmp_path):

@@ -197,24 +197,25 @@ def run(args) -> int:
     posterior = build_posterior(args, data, robust=args.robust)
     references = parse_references(args.reference, posterior)
     check_walkers(args.walkers, posterior.ndim)
-    if not args.restart:
-        check_resumable(out / "chain.h5", posterior, args.walkers, args.seed)
     made_folder = not out.exists()
     chain = out / "chain.h5"
-    with folder_lock(out):
-        if not args.quiet:
-            print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
-                  f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}", file=sys.stderr)
-        if args.restart and (old := set_aside(chain)) is not None and not args.quiet:
-            print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
-        fresh = not chain.exists()
+    fresh = not chain.exists()
+    with folder_lock(out):  # first: a second run on this folder stops here, before it reads the chain
         try:
+            if not args.restart:
+                check_resumable(chain, posterior, args.walkers, args.seed)
+            if not args.quiet:
+                print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
+                      f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}",
+                      file=sys.stderr)
+            if args.restart and (old := set_aside(chain)) is not None and not args.quiet:
+                print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
             inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,
                          backend_path=chain, progress=not args.quiet)
         except KeyboardInterrupt:
             raise  # the chain so far is kept: the same command continues it
         except BaseException:
-            _discard_unstarted(chain, out, fresh, made_folder)
+            _discard_unstarted(chain, out, fresh or args.restart, made_folder)
             raise
         if not args.quiet:
             print("  writing the report (figures, posterior.nc, summary.json, report.html)", file=sys.stderr)

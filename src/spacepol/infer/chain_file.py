@@ -64,3 +64,18 @@ def set_aside(path) -> Path | None:
     old = path.with_name(path.name + ".old")
     os.replace(path, old)
     return old
+
+
+def compact(path) -> None:
+    """Rewrite a finished chain file without the free space HDF5 leaves behind: emcee rewrites the
+    random state at every step and grows the datasets block by block, and HDF5 never reclaims the old
+    space (a PTFE run's 15 MB of chain filled a 42 MB file).  Atomic: a copy renamed into place."""
+    import h5py
+
+    from ..io.atomic import atomic_path
+
+    path = Path(path)
+    with atomic_path(path) as tmp, h5py.File(path, "r") as src, h5py.File(tmp, "w") as dst:
+        dst.attrs.update(src.attrs)
+        for name in src:
+            src.copy(src[name], dst, name=name)

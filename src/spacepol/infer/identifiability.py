@@ -75,8 +75,9 @@ def bound_finding(flag: dict) -> str:
     name, b = flag["parameter"], flag["bound"]
     where = f"(median {flag['median']:.4g}, 90 % [{flag['q05']:.4g}, {flag['q95']:.4g}])"
     if flag["physical_limit"]:
-        return (f"{name} sits at its physical limit {b:g} {where}: possible only if the material really has "
-                f"{name} = {b:g}; otherwise the model is wrong and {name} is absorbing a missing effect.")
+        return (f"{name} reaches its physical limit {b:g} {where}: the data are consistent with {name} = {b:g} and the "
+                f"interval is cut off there; if the material cannot have {name} = {b:g}, the model is missing an effect "
+                f"that {name} absorbs.")
     return (f"{name} sits at its {flag['side']} bound {b:g} {where}: the model or the prior is wrong "
             f"(the posterior is cut off by the prior, so its interval is not a measurement).")
 

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 
 from ..errors import SpacepolError
-from .chain_file import chain_iterations
+from .chain_file import chain_iterations, compact
 from .diagnostics import convergence, fit_statistics, loo, quantiles
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
@@ -88,6 +88,8 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
                           check_every=check_every,
                           initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
+    if backend_path is not None:
+        compact(backend_path)
     idata = to_inference_data(result, posterior, rng)
     loo_result = loo(idata)
     summary = {

@@ -1,0 +1,62 @@
+"""A posterior piled against a prior bound is flagged and never called well constrained."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from spacepol.infer.identifiability import at_bounds, bound_finding
+from spacepol.infer.prior_set import PriorSet
+from spacepol.physics import Model
+
+
+def _posterior():
+    model = Model.from_string("paper")
+    return SimpleNamespace(priors=PriorSet(model.parameters))
+
+
+def _flat(post, **columns):
+    rng = np.random.default_rng(1)
+    names = post.priors.names
+    mid = {n: 0.5 * sum(post.priors.priors[n].bounds) for n in names}
+    return np.column_stack([columns.get(n, mid[n] + 1e-3 * rng.standard_normal(4000)) for n in names]), names
+
+
+def test_a_posterior_cut_off_by_the_prior_is_flagged_and_one_inside_is_not():
+    post = _posterior()
+    lo_n = post.priors.priors["n"].lower
+    rng = np.random.default_rng(0)
+    piled = lo_n + np.abs(0.02 * rng.standard_normal(4000))  # a half-normal against the bound: PTFE's n
+    flat, names = _flat(post, n=piled)
+    flags = at_bounds(post, flat, names)
+    assert [(f["parameter"], f["side"]) for f in flags] == [("n", "lower")]
+    text = bound_finding(flags[0])
+    assert f"n sits at its lower bound {lo_n:g}" in text and "the model or the prior is wrong" in text
+
+    # negative controls: narrow and well inside (10 sd from the bound), and flat over the whole prior
+    near = lo_n + 0.1 + 0.01 * rng.standard_normal(4000)
+    flat_prior = post.priors.priors["n"].sample(rng, 4000)
+    for column in (near, flat_prior):
+        flat, names = _flat(post, n=column)
+        assert at_bounds(post, flat, names) == []
+
+
+def test_the_physical_limit_is_worded_as_such():
+    post = _posterior()
+    rng = np.random.default_rng(2)
+    flat, names = _flat(post, k=np.abs(0.05 * rng.standard_normal(4000)))
+    (flag,) = at_bounds(post, flat, names)
+    assert flag["parameter"] == "k" and flag["physical_limit"]
+    assert "reaches its physical limit 0" in bound_finding(flag)
+
+
+def test_identifiability_never_calls_a_flagged_parameter_well_constrained():
+    from spacepol.infer.identifiability import identifiability
+
+    post = _posterior()
+    post.likelihood = SimpleNamespace(observables=["dop", "brdf"])
+    rng = np.random.default_rng(3)
+    flat, names = _flat(post, n=post.priors.priors["n"].lower + np.abs(0.02 * rng.standard_normal(4000)))
+    result = SimpleNamespace(flat_samples=lambda: flat, names=names)
+    findings = identifiability(post, result)["findings"]
+    assert any("sits at its lower bound" in f for f in findings)
+    assert not any("well constrained" in f for f in findings)

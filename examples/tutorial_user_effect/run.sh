@@ -3,6 +3,8 @@
 #   sh examples/tutorial_user_effect/run.sh [OUT_DIR]
 set -e
 OUT=${1:-reports/tutorial}
+# the project's environment when it is there (after the README's set-up), else whatever is on PATH
+if [ -x .venv/bin/invert-mcmc ]; then PATH="$PWD/.venv/bin:$PATH"; fi
 E=examples/tutorial_user_effect/sheen.py:Sheen
 mkdir -p "$OUT"
 # 1. the new effect is registered like a built-in one

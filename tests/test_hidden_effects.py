@@ -10,7 +10,7 @@ import pytest
 from scipy import stats
 
 from spacepol.criticism.hidden_effects import HIDDEN_VALUES, Case, effect_size, run_suite, suite, summarise
-from spacepol.criticism.diagnose import _candidates
+from spacepol.criticism.changes import changes
 from spacepol.physics import Model
 from spacepol.physics.builtin_effects import BUILTIN_EFFECTS
 
@@ -19,7 +19,7 @@ def test_suite_covers_every_composable_builtin_effect_and_null_sets():
     from spacepol.criticism.hidden_effects import measurement
 
     cases = suite()
-    composable = {name for name, _ in _candidates(Model.from_string("paper"), measurement(cases[0]))}
+    composable = {c.effect for c in changes(Model.from_string("paper"), measurement(cases[0])) if c.kind == "add"}
     assert set(HIDDEN_VALUES) == composable & {cls.name for cls in BUILTIN_EFFECTS}
     hidden = [c for c in cases if c.effect]
     assert {c.effect for c in hidden} == set(HIDDEN_VALUES)

@@ -107,11 +107,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", required=True, metavar="FILE", help="write the ranking here")
     p.add_argument("--candidates", nargs="+", default=None, help="effects to consider (default: every registered one)")
     p.add_argument("--top", type=_int_at_least(1), default=3, help="candidates confirmed by a full refit")
+    p.add_argument("--rounds", type=_int_at_least(1), default=None, metavar="N",
+                   help="accept the best significant change and continue from the changed model, up to N rounds")
     p.add_argument("--out", default="reports/diagnose")
 
     p = sub.add_parser("ladder", help="fit M, M + E1, M + E1 + E2, ...: the error falling rung by rung")
     data_options(p)
-    p.add_argument("--add", action="append", required=True, metavar="EFFECT", help="effect added at the next rung")
+    p.add_argument("--add", action="append", default=[], metavar="CHANGE",
+                   help="the next rung's change: an effect to add, or 'replace A by B', or 'remove E' (repeatable)")
+    p.add_argument("--replay", metavar="DIAGNOSE.json", help="replay the path of `diagnose --rounds` (its changes, in order)")
     p.add_argument("--json", metavar="FILE", help="write the rungs here (default DIR/ladder.json)")
     p.add_argument("--out", default="reports/ladder")
 

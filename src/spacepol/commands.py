@@ -307,21 +307,36 @@ def diagnose(args) -> int:
         raise ParameterError(f"--top {args.top}: need at least 1")
     data = load_dataset(args)
     observables = parse_observables(args.observables)
-    report = run_diagnose(data, model, np.random.default_rng(args.seed), seed=args.seed, observables=observables,
-                          candidates=args.candidates, top=args.top, priors=priors)
-    base, confirmed = report.pop("_base"), report.pop("_confirmed")
-    write_diagnose_report(report, base, confirmed, Path(args.out), str(args.data))
+    rng = np.random.default_rng(args.seed)
+    if args.rounds:
+        from .criticism.rounds import as_rungs, diagnose_rounds
+
+        result = diagnose_rounds(data, model, rng, args.rounds, seed=args.seed, observables=observables,
+                                 candidates=args.candidates, top=args.top, priors=priors)
+        rungs = as_rungs(result)
+        first = result.pop("_reports")[0]
+        report = result
+        base, confirmed = first["_base"], first["_confirmed"]
+    else:
+        report = run_diagnose(data, model, rng, seed=args.seed, observables=observables,
+                              candidates=args.candidates, top=args.top, priors=priors)
+        base, confirmed = report.pop("_base"), report.pop("_confirmed")
+        rungs = None
+    write_diagnose_report(report, base, confirmed, Path(args.out), str(args.data), path_rungs=rungs)
     write_json(args.json, report)
     lead = report["ranking"][0] if report["ranking"] else None
-    print(f"verdict: {report['verdict']}" + (f" ({lead['effect']}: delta ELPD {lead['delta_elpd']:+.1f} +- "
+    print(f"verdict: {report['verdict']}" + (f" ({lead['change']}: delta ELPD {lead['delta_elpd']:+.1f} +- "
                                              f"{lead['delta_elpd_se']:.1f})" if lead and lead["delta_elpd"] is not None else ""))
     print(report["conclusion"])
     print(significance_statement(report))
+    if args.rounds:
+        print(report["conclusion_rounds"])
     print(f"wrote {args.json}; figures and report.html in {args.out}")
     return 0
 
 
 def ladder(args) -> int:
+    from .criticism.changes import parse
     from .criticism.ladder import climb
     from .report.ladder_report import write_ladder_report
 
@@ -329,16 +344,38 @@ def ladder(args) -> int:
     if args.json:
         check_output_file(args.json, "--json")
     model = build_model(args.model)
+    steps = list(args.add)
+    if args.replay:
+        steps = replay_steps(args.replay, model) + steps
+    if not steps:
+        raise ParameterError("ladder: give at least one --add CHANGE or --replay DIAGNOSE.json")
     current = model
-    for name in args.add:  # check the whole ladder composes before fitting anything
-        current = current + name
+    for step in steps:  # check the whole ladder composes before fitting anything
+        current = parse(current, step).model
     data = load_dataset(args)
     observables = parse_observables(args.observables)
-    rungs = climb(data, model, args.add, seed=args.seed, observables=observables)
+    rungs = climb(data, model, steps, seed=args.seed, observables=observables)
     out = Path(args.out)
     print("\n".join(write_ladder_report(rungs, out, args.json)))
     print(f"wrote {args.json or out / 'ladder.json'}, {out / 'ladder.png'}, {out / 'ladder.md'}")
     return 0
+
+
+def replay_steps(path, model: Model) -> list[str]:
+    """The changes of a `diagnose --rounds` JSON, checked to start from ``model``."""
+    import json
+
+    try:
+        report = json.loads(Path(path).read_text(encoding="utf-8"))
+        rounds = report["rounds"]
+        start, steps = rounds[0]["model"], [r["change"] for r in rounds[1:]]
+    except FileNotFoundError:
+        raise ParameterError(f"--replay {path}: file not found") from None
+    except (ValueError, KeyError, IndexError, TypeError, UnicodeDecodeError):
+        raise ParameterError(f"--replay {path}: not the JSON of `diagnose --rounds` (no 'rounds' path)") from None
+    if start != model.name:
+        raise ParameterError(f"--replay {path}: its path starts from {start}, not from --model {model.name}")
+    return [s for s in steps if isinstance(s, str)]
 
 
 def _parse_direction(text: str) -> tuple[float, float]:

@@ -1,13 +1,16 @@
 """Which physical effect is missing: screen every registered effect, confirm the leaders.
 
 1. Fit the model M (emcee) and keep its pointwise PSIS-LOO.
-2. Screening: for every registered effect E not in M (built-in or plug-in) that composes with
-   M, a quick differential-evolution maximum of the log posterior of M + E; the gain over M's
-   maximum (a likelihood-ratio statistic) ranks the candidates.
+2. Screening: for every change of M (``criticism.changes``: each registered effect added, each
+   slot member replaced by another of its slot, each removable effect removed; built-ins and
+   plug-ins alike), a quick global maximum of the log posterior of the changed model; the gain
+   over M's maximum (a likelihood-ratio statistic) ranks the candidates.
 3. Confirmation: the ``top`` candidates are refitted with emcee; the change in ELPD-LOO and its
    standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4.
-4. Twins: confirmed candidates whose pointwise LOO agree within noise (difference < 1 SE) are
-   reported as tied; the explanation says what measurement separates them.
+4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
+   explanation says what measurement separates them (as the effects declare it). Effects declared
+   twins are always refitted together.
+5. A significant change whose residuals stay structured "helps, but does not explain the misfit".
 """
 
 from __future__ import annotations
@@ -27,30 +30,10 @@ from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
-
-SEPARATING_MEASUREMENT = {
-    frozenset({"extinction", "depolarization"}): "the full Mueller matrix (an analyser acts on the detector side only, "
-    "depolarization on the light itself: M01 and M10 differ)",
-}
-
+from .changes import changes, separating_measurement, start_points
 
 def _first_sentence(text: str) -> str:
     return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."
-
-
-def _candidates(model: Model, data, names=None):
-    out = []
-    for name in names or registry.names():
-        if name in [e.name for e in model.effects]:
-            continue
-        try:
-            candidate = model + name
-        except SpacepolError:
-            continue  # does not compose with M (e.g. smith with shadowing)
-        if name == "oxide_layer" and (data.wavelength_um is None or np.any(~np.isfinite(data.wavelength_um))):
-            continue
-        out.append((name, candidate))
-    return out
 
 
 def _build(data, model, observables, priors):
@@ -63,8 +46,8 @@ def _build(data, model, observables, priors):
 def check_prior_names(data, model: Model, priors: dict, observables=None, candidates=None) -> None:
     """Every overridden prior must belong to the base model or to one of the candidates."""
     known = {p.name for p in Posterior.build(data, model, observables=observables).priors.parameters}
-    for _, candidate in _candidates(model, data, candidates):
-        known |= {p.name for p in candidate.parameters}
+    for change in changes(model, data, candidates):
+        known |= {p.name for p in change.model.parameters}
     unknown = sorted(set(priors or {}) - known)
     if unknown:
         raise SpacepolError(f"--prior: no parameter(s) {', '.join(unknown)} in {model.name} or any candidate effect")
@@ -79,26 +62,6 @@ def _vector(values: dict, posterior) -> np.ndarray:
     return np.array([values[n] for n in posterior.priors.names], float)
 
 
-def nested_seeds(base_best: dict, candidate, posterior) -> np.ndarray:
-    """Start points of M + E at M's optimum: E's own parameters at their prior's lower end, default,
-    upper end and middle (most effects vanish at one of them: rho_pd = 0, e = 1, delta = 0, ...);
-    a parameter that splits one of M's (sigma -> sigma_x, sigma_y) starts at its value."""
-    params = {p.name: p for p in candidate.parameters}
-    rows = []
-    for option in range(4):
-        row = []
-        for name in posterior.priors.names:
-            if name in base_best:
-                row.append(base_best[name])
-                continue
-            split = [r for r in base_best if name.startswith(r + "_")]
-            lo, hi = posterior.priors.priors[name].bounds
-            default = params[name].default if name in params else 0.5 * (lo + hi)
-            row.append(base_best[split[0]] if split else [lo, default, hi, 0.5 * (lo + hi)][option])
-        rows.append(row)
-    return np.clip(np.array(rows), posterior.priors.bounds[:, 0], posterior.priors.bounds[:, 1])
-
-
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
              priors: dict | None = None, base=None) -> dict:
@@ -108,7 +71,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
     base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
-    all_candidates = _candidates(model, data, candidates)
+    all_candidates = changes(model, data, candidates)
     if base is None:
         if progress:
             _say(f"[base] fitting {model.name} with emcee ({len(data)} geometries) ...")
@@ -120,24 +83,27 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     if progress:
         _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
     screened = []
-    for i, (name, candidate) in enumerate(all_candidates, start=1):
-        post = _build(data, candidate, observables, priors)
-        best, optimum = _screen(post, rng, screening_evaluations, seeds=nested_seeds(base_optimum, candidate, post))
+    for i, change in enumerate(all_candidates, start=1):
+        post = _build(data, change.model, observables, priors)
+        best, optimum = _screen(post, rng, screening_evaluations, seeds=start_points(base_optimum, change, post))
         gain = best - base_best
-        screened.append({"effect": name, "model": candidate, "posterior": post, "screening_gain": float(gain),
-                         "optimum": _vector(optimum, post)})
+        screened.append({"effect": change.effect, "change": change.label, "_change": change, "model": change.model,
+                         "posterior": post, "screening_gain": float(gain), "optimum": _vector(optimum, post)})
         if progress:
-            _say(f"[screen {i}/{len(all_candidates)}] {name:<18s} max log posterior gain {gain:9.2f} "
+            _say(f"[screen {i}/{len(all_candidates)}] {change.label:<32s} max log posterior gain {gain:9.2f} "
                  f"({time.perf_counter() - clock['start']:.0f} s)")
     screened.sort(key=lambda c: -c["screening_gain"])
 
     clock["screening"] = time.perf_counter()
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
     to_confirm = screened[:top] + [c for c in screened[top:] if screened and _close(c["screening_gain"], screened[0]["screening_gain"])]
+    # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits
+    twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
+    to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:
-            _say(f"[confirm {i}/{len(to_confirm)}] {c['effect']}: emcee posterior and PSIS-LOO "
+            _say(f"[confirm {i}/{len(to_confirm)}] {c['change']}: emcee posterior and PSIS-LOO "
                  f"({time.perf_counter() - clock['start']:.0f} s)")
         # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
         inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False, centre=c["optimum"])
@@ -148,29 +114,39 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         c["significant"] = significant(c["delta_elpd"], c["delta_elpd_se"])
         confirmed.append(c)
     confirmed.sort(key=lambda c: -c["delta_elpd"])
+    if confirmed and confirmed[0]["significant"]:
+        # changes that fit equally well (tied with the best): the one with fewer free parameters leads
+        group = [c for c in confirmed if c["significant"] and (c is confirmed[0] or _tied(confirmed[0], c))]
+        simplest = min(group, key=lambda c: (c["posterior"].ndim, -c["delta_elpd"]))
+        confirmed.remove(simplest)
+        confirmed.insert(0, simplest)
     clock["confirmation"] = time.perf_counter()
 
     ranking = []
     for i, c in enumerate(confirmed):
-        entry = {k: c[k] for k in ("effect", "delta_elpd", "delta_elpd_se", "rmse_dop_after", "significant")}
+        entry = {k: c[k] for k in ("effect", "change", "delta_elpd", "delta_elpd_se", "rmse_dop_after", "significant")}
+        entry["explains_misfit"] = not _structured(c["inversion"].summary)
         entry["screening_gain"] = c["screening_gain"]
         entry["explanation"] = _explain(c, base)
         ranking.append(entry)
     for c in screened[len(to_confirm):]:
-        ranking.append({"effect": c["effect"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
+        ranking.append({"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
                         "significant": False, "screening_gain": c["screening_gain"],
                         "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."})
     verdict = "none"
     if confirmed and confirmed[0]["significant"]:
         lead = confirmed[0]
-        verdict = lead["effect"]
-        tied = [c["effect"] for c in confirmed[1:] if c["significant"] and _tied(lead, c)]
+        verdict = lead["_change"].verdict
+        tied = [c for c in confirmed[1:] if c["significant"] and _tied(lead, c)]
         if tied:
-            ranking[0]["tied_with"] = tied
+            ranking[0]["tied_with"] = [c["_change"].verdict for c in tied]
             for other in tied:
-                sep = SEPARATING_MEASUREMENT.get(frozenset({lead["effect"], other}), "a measurement in which they predict differently")
-                ranking[0]["explanation"] += (f" It fits these data as well as {other} (equal within noise): the two are twins "
-                                              f"here; {sep} would separate them.")
+                sep = None
+                if lead["_change"].kind == other["_change"].kind == "add":
+                    sep = separating_measurement(lead["effect"], other["effect"])
+                sep = sep or "a measurement in which they predict differently"
+                ranking[0]["explanation"] += (f" It fits these data as well as '{other['change']}' (equal within noise): the "
+                                              f"two are twins here; {sep} would separate them.")
     return {"model": model.name, "fit": base.summary["fit"], "ranking": ranking, "verdict": verdict,
             "residual_structure": base.summary["residual_structure"]["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
@@ -243,15 +219,16 @@ def _conclusion(base, confirmed, verdict) -> str:
                     "effect and rerun diagnose.")
         return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary['model']} "
                 "look like noise: nothing is missing at this noise level.")
-    after = next(c for c in confirmed if c["effect"] == verdict)["inversion"].summary
-    text = f"Add {verdict}: it is the candidate that improves ELPD-LOO most, by more than 2 SE."
+    lead = next(c for c in confirmed if c["_change"].verdict == verdict)
+    after = lead["inversion"].summary
+    text = f"{lead['change'][0].upper()}{lead['change'][1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
     if _structured(after):
-        text += (f" After adding it the residuals are still structured ({describe_fit(after)}"
-                 + "; " + " ".join(after["residual_structure"]["findings"])
-                 + "): run diagnose again on the extended model; if nothing else in the library helps, the rest comes "
-                 "from an effect outside it.")
+        text += (f" It helps, but does not explain the misfit (partly explained): after it the residuals are still "
+                 f"structured ({describe_fit(after)}; " + " ".join(after["residual_structure"]["findings"])
+                 + "). Run diagnose again on the changed model (or use --rounds); if nothing else in the library helps, "
+                 "the rest comes from an effect outside it.")
     else:
-        text += f" After adding it the residuals look like noise ({describe_fit(after)})."
+        text += f" After it the residuals look like noise ({describe_fit(after)}): explained."
     return text
 
 
@@ -266,6 +243,10 @@ def _tied(a, b) -> bool:
 def _explain(c, base) -> str:
     cls = registry.get(c["effect"])
     physics = _first_sentence(cls.description)
+    if c["_change"].kind == "replace":
+        physics = f"Replace {c['_change'].replaced} by {c['effect']}: {physics}"
+    elif c["_change"].kind == "remove":
+        physics = f"Remove {c['effect']} ({physics[0].lower()}{physics[1:]})"
     rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c["rmse_dop_after"]
     rmse = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
     noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c["inversion"].summary)
@@ -280,5 +261,8 @@ def _explain(c, base) -> str:
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
                    f"correlates {s['correlation']:+.2f} with the residuals and {change}")
     bounds = [bound_finding(f) for f in c["inversion"].summary["identifiability"].get("at_bound", [])]
+    if c["significant"] and _structured(c["inversion"].summary):
+        bounds.insert(0, "it helps, but does not explain the misfit: after it the residuals are still structured ("
+                      + " ".join(c["inversion"].summary["residual_structure"]["findings"]) + ").")
     return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
             f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))

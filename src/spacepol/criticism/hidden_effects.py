@@ -25,6 +25,7 @@ from ..infer.posterior import Posterior
 from ..io.measurements import Dataset
 from ..physics.geometry import Geometry, default_grid
 from ..physics.model import Model
+from ..physics.registry import registry
 from .diagnose import diagnose
 
 BASE = "paper"
@@ -41,6 +42,7 @@ HIDDEN_VALUES = {  # per built-in effect: a small and a large value, inside the 
     "extinction": [{"e": 0.9}, {"e": 0.7}],
     "dop_bias": [{"bias": 0.01}, {"bias": 0.05}],
     "oxide_layer": [{"thickness_um": 0.05, "n_film": 1.46}, {"thickness_um": 0.25, "n_film": 1.7}],
+    "lambertian": [{"rho_l": 0.05}, {"rho_l": 0.3}],
 }
 NOISE = [(0.002, 0.01), (0.01, 0.05)]  # (DOP absolute, BRDF relative): a good lab polarimeter, a field one
 WAVELENGTH_UM = 0.633
@@ -123,21 +125,13 @@ def effect_size(case: Case, rng: np.random.Generator, evaluations: int = 6000) -
 
 
 def identifiable(effect: str, names: list[str], samples: np.ndarray, truth: dict) -> tuple[np.ndarray, dict]:
-    """Samples and truth in a form the data can identify. Anisotropy is invariant under
-    (sigma_x, sigma_y, psi) -> (sigma_y, sigma_x, psi + 90) and psi -> psi + 180: order the widths
-    (sigma_x <= sigma_y) and take psi modulo 180 after the swap."""
-    if effect != "anisotropy":
-        return samples, truth
-
-    def canonical(sx, sy, psi):
-        swap = sx > sy
-        return np.where(swap, sy, sx), np.where(swap, sx, sy), np.where(swap, psi + 90.0, psi) % 180.0
-
-    j = [names.index(n) for n in ("sigma_x", "sigma_y", "psi")]
-    out = samples.copy()
-    out[:, j[0]], out[:, j[1]], out[:, j[2]] = canonical(samples[:, j[0]], samples[:, j[1]], samples[:, j[2]])
-    t = canonical(np.float64(truth["sigma_x"]), np.float64(truth["sigma_y"]), np.float64(truth["psi"]))
-    return out, {**truth, "sigma_x": float(t[0]), "sigma_y": float(t[1]), "psi": float(t[2])}
+    """Samples and truth in the form the data can identify, as the effect itself declares it
+    (``Effect.identifiable``: e.g. anisotropy's label swaps)."""
+    canonical = registry.get(effect)().identifiable
+    values = canonical({n: samples[:, j] for j, n in enumerate(names)})
+    out = np.column_stack([np.asarray(values[n], float) for n in names])
+    t = canonical({k: np.float64(v) for k, v in truth.items()})
+    return out, {k: float(t[k]) for k in truth}
 
 
 def covered(effect: str, inversion, truth: dict) -> dict[str, bool]:
@@ -158,7 +152,7 @@ def score(case: Case, report: dict) -> dict:
            "noise_dop": case.noise_dop, "size": case.size, "verdict": report["verdict"], "tied_with": lead.get("tied_with", []),
            "correct": (report["verdict"] == "none") if case.effect is None else (case.effect in named),
            "chi2_red_base": report["fit"]["chi2_red"]}
-    confirmed = {c["effect"]: c for c in report["_confirmed"]}
+    confirmed = {c["effect"]: c for c in report["_confirmed"] if c["_change"].kind == "add"}
     if case.effect in confirmed:
         inversion = confirmed[case.effect]["inversion"]
         out["chi2_red_after"] = inversion.summary["fit"]["chi2_red"]

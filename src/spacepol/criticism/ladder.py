@@ -1,4 +1,5 @@
-"""The ladder: fit M, then M + E1, then M + E1 + E2, ...; show the error fall rung by rung."""
+"""The ladder: fit M, then M changed once, twice, ... (added, replaced or removed effects); show the error
+fall rung by rung."""
 
 from __future__ import annotations
 
@@ -10,32 +11,38 @@ from ..infer.inversion import invert
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
-from .diagnose import nested_seeds
+from .changes import parse, start_points
 
 
 def climb(data, model: Model, additions: list[str], seed: int = 0, observables=None, max_steps: int = 8000,
           progress: bool = True, fitted: dict | None = None) -> list[dict]:
-    """``fitted``: {model name: Inversion} already at hand on these data (e.g. from diagnose); reused."""
+    """One rung per change: ``additions`` are effect names or change labels ("replace shadowing by smith",
+    "remove body"), applied in order.  ``fitted``: {model name: Inversion} already at hand on these data
+    (e.g. from diagnose); reused."""
     rungs, current, fitted = [], model, fitted or {}
     for step in [None] + list(additions):
+        change = None
         if step is not None:
-            current = current + step
+            change = parse(current, step)
+            current = change.model
         inv = fitted.get(current.name)
         if inv is None:
             if progress:
                 print(f"  [rung {len(rungs)}/{len(additions)}] fitting {current.name} with emcee ...", file=sys.stderr, flush=True)
             post = Posterior.build(data, current, observables=observables)
             centre = None
-            if rungs:  # start from the previous rung's optimum, the new effect at its neutral values
-                seeds = nested_seeds(rungs[-1]["_inversion"].summary["map"], current, post)
+            if rungs:  # start from the previous rung's optimum, the change's new parameters at neutral values
+                seeds = start_points(rungs[-1]["_inversion"].summary["map"], change, post)
                 centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
             inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
         fit = inv.summary["fit"]
-        rungs.append({"model": current.name, "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
+        rungs.append({"model": current.name, "change": None if change is None else change.label,
+                      "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
                       "inferred_noise": inferred_noise(inv), "noise_known": not inferred_noise(inv),
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"], "parameters": inv.summary["parameters"],
                       "at_bound": inv.summary["identifiability"].get("at_bound", []),
+                      "residual_structure": inv.summary["residual_structure"]["findings"],
                       "_inversion": inv})
     return rungs
 

@@ -21,21 +21,23 @@ def _spread(x):
     return float(np.subtract(*np.percentile(x, [95, 5])))
 
 
-def _intensity_ratio_findings(flat, names, lobe):
-    """DOP is a ratio of intensities: k_s and the diffuse albedo enter only through their ratio
-    (and, in the exact specular geometry, through k_s / (sigma^2 rho_d))."""
-    log = {n: np.log(np.maximum(flat[:, names.index(n)], 1e-300)) for n in ("ks", lobe) + (("sigma",) if "sigma" in names else ())}
+def _intensity_ratio_findings(flat, names, ks, lobe):
+    """DOP is a ratio of intensities: the specular weight and a diffuse albedo enter only through their
+    ratio (and, in the exact specular geometry, through k_s / (sigma^2 rho_d))."""
+    log = {n: np.log(np.maximum(flat[:, names.index(n)], 1e-300)) for n in (ks, lobe) + (("sigma",) if "sigma" in names else ())}
+    log["ks"] = log[ks]
+    shown = "k_s" if ks == "ks" else ks
     alone = min(_spread(log["ks"]), _spread(log[lobe]))
     ratio = _spread(log["ks"] - log[lobe])
     out = []
     if ratio < 0.5 * alone:
-        out.append(f"From DOP alone only the ratio k_s/{lobe} is measured (90 % range of its log {ratio:.2f}, against "
+        out.append(f"From DOP alone only the ratio {shown}/{lobe} is measured (90 % range of its log {ratio:.2f}, against "
                    f"{alone:.2f} for either alone): DOP is a ratio of intensities, so scaling both lobes together changes "
                    f"nothing. Add BRDF (intensity) data to separate them.")
     elif "sigma" in log:
         folded = _spread(log["ks"] - log[lobe] - 2 * log["sigma"])
         if folded < 0.5 * min(alone, ratio, _spread(log["sigma"])):
-            out.append(f"From DOP alone only k_s/(sigma^2 {lobe}) is measured (90 % range of its log {folded:.2f}, against "
+            out.append(f"From DOP alone only {shown}/(sigma^2 {lobe}) is measured (90 % range of its log {folded:.2f}, against "
                        f"{alone:.2f} for k_s or {lobe} alone): at the specular peak the facet distribution is 1/(2 pi sigma^2), "
                        f"so roughness folds into the intensity ratio. Off-specular geometries fix sigma; BRDF data fix k_s and {lobe}.")
     if not out:
@@ -103,9 +105,10 @@ def identifiability(posterior: Posterior, result: Result) -> dict:
             if abs(corr[a, b]) > STRONG_CORRELATION:
                 pairs.append((names[a], names[b], float(corr[a, b])))
     observables = posterior.likelihood.observables
-    lobes = [n for n in ("rho_d", "rho_pd") if n in names]
-    if "ks" in names and lobes and "brdf" not in observables:
-        findings.extend(_intensity_ratio_findings(flat, names, lobes[0]))
+    # effects declare the parameter that scales their lobe; DOP measures only ratios of them
+    scales = [e.intensity for e in posterior.likelihood.model.effects if e.intensity in names]
+    if len(scales) >= 2 and "brdf" not in observables:
+        findings.extend(_intensity_ratio_findings(flat, names, scales[0], scales[1]))
     for a, b, r in pairs:
         findings.append(f"{a} and {b} are strongly correlated (r = {r:+.2f}): the data fix a combination of them better than either.")
     if not findings:

@@ -2,9 +2,10 @@
 
 Three searches, the best (by the full posterior) wins:
 * differential evolution on the prior cube;
-* the dielectric branch: k ~ 0 (PTFE, paints, glass) is a sliver of the cube under the default
-  prior k ~ U(0, 20) (k < 0.05 is 0.25 % of it) and DE converges on an absorbing optimum before
-  it looks there, so when k is free a second DE runs with k pinned at 0;
+* the branches the model's effects declare (``Effect.branches``): e.g. the dielectric k = 0 of
+  ``specular`` (PTFE, paints, glass) is a sliver of the cube under the default prior k ~ U(0, 20)
+  (k < 0.05 is 0.25 % of it) and DE converges on an absorbing optimum before it looks there, so a
+  second DE runs with k pinned at 0;
 * a multistart: 8192 scrambled Sobol points, the best 8 polished by L-BFGS-B. Thin films make the
   posterior a comb of interference orders in which DE settles on a wrong tooth (a film hidden
   at 0.25 um: DE -443, multistart +845 in log posterior, the truth +841).
@@ -20,14 +21,19 @@ from .posterior import Posterior
 from .priors import Fixed
 
 
-def _dielectric_branch(posterior: Posterior) -> Posterior | None:
+def _branches(posterior: Posterior):
+    """The posterior restricted to each ``branch`` an effect of the model declares (parameter values
+    inside the prior that a global search would miss): the dielectric k = 0 of ``specular`` ..."""
     priors = posterior.priors
-    if "k" not in priors.names or priors.priors["k"].bounds[0] > 0:
-        return None
-    overrides = {name: prior for name, prior in priors.priors.items() if name != "k"}
-    overrides["k"] = Fixed(0.0)
-    return Posterior(posterior.likelihood, type(priors)(priors.parameters, overrides, where="dielectric branch"),
-                     prior_only=posterior.prior_only)
+    for effect in posterior.likelihood.model.effects:
+        for branch in effect.branches:
+            pinned = {n: v for n, v in branch.items() if n in priors.names}
+            if not pinned or any(not priors.priors[n].bounds[0] <= v <= priors.priors[n].bounds[1] for n, v in pinned.items()):
+                continue
+            overrides = {name: prior for name, prior in priors.priors.items() if name not in pinned}
+            overrides.update({n: Fixed(float(v)) for n, v in pinned.items()})
+            sub = type(priors)(priors.parameters, overrides, where=f"{effect.name} branch {pinned}")
+            yield pinned, Posterior(posterior.likelihood, sub, prior_only=posterior.prior_only)
 
 
 def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: int = 4000, seeds=None,
@@ -35,11 +41,11 @@ def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: in
     """(max log posterior, parameter vector in ``posterior.priors.names`` order)."""
     res = run_de(NegativeLogPosterior(posterior), rng, max_evaluations=evaluations, popsize=popsize, polish=True, seeds=seeds)
     best_value, best = -res.objective, res.best_vector()
-    branch = _dielectric_branch(posterior)
-    if branch is not None:
-        sub_seeds = None if seeds is None else np.delete(np.atleast_2d(seeds), posterior.priors.names.index("k"), axis=1)
+    for pinned, branch in _branches(posterior):
+        keep = [j for j, n in enumerate(posterior.priors.names) if n not in pinned]
+        sub_seeds = None if seeds is None else np.atleast_2d(seeds)[:, keep]
         sub = run_de(NegativeLogPosterior(branch), rng, max_evaluations=evaluations, popsize=popsize, polish=True, seeds=sub_seeds)
-        values = {**sub.best, "k": 0.0}
+        values = {**sub.best, **pinned}
         theta = np.array([values[n] for n in posterior.priors.names])
         value = float(posterior.log_prob(theta[None, :])[0])
         if value > best_value:

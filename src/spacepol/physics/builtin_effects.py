@@ -46,6 +46,8 @@ class Specular(Effect):
         "Brewster's angle for dielectrics; roughness sigma widens the lobe but leaves the DOP of the "
         "lobe itself unchanged."
     )
+    intensity = "ks"
+    branches = ({"k": 0.0},)  # dielectrics (PTFE, paints, glass): k < 0.05 is 0.25 % of the default k prior
 
     def distribution(self, ctx: Context):
         geo = ctx.geometry
@@ -130,6 +132,8 @@ class Shadowing(Effect):
         "incidence or exit; it multiplies S0, S1 and S2 alike, so it changes DOP only through the "
         "balance with the diffuse lobes. Its four constants are fixed at the paper's values unless freed."
     )
+    slot = "shadowing"
+    removable = True
 
     def specular_factor(self, ctx):
         params = [ctx[name] for name in PAPER_CONSTANTS]
@@ -151,6 +155,8 @@ class Smith(Effect):
         "anisotropic widths projected on each beam's azimuth). Physically consistent replacement of "
         "the paper's empirical `shadowing`; darkens grazing geometries, DOP of the lobe unchanged."
     )
+    slot = "shadowing"
+    removable = True
 
     # Exact Lambda; renderers use Walter et al.'s rational fit (facets.smith_g1_beckmann_walter).
     beckmann_g1 = staticmethod(facets.smith_g1_beckmann)
@@ -183,6 +189,10 @@ class Body(Effect):
         "specular lobe is weak. Note: because of its cos(theta_r) factor it is neither Lambertian "
         "(rho_d/pi would be) nor reciprocal; eq 23's DOP follows only with this depolarizing M^d."
     )
+    slot = "body"
+    removable = True
+    intensity = "rho_d"
+    neutral = {"rho_d": 0.0}
 
     def lobe(self, ctx):
         return ctx.depolarized((ctx["rho_d"] / np.pi) * ctx.geometry.cos_tr)
@@ -201,6 +211,10 @@ class PolarizedDiffuse(Effect):
         "favours p, so this light is partly polarized parallel to the exit plane (S1 < 0), most at "
         "grazing exit: it raises |DOP| at large theta_r and can flip the sign of S1 far from the specular lobe."
     )
+    slot = "body"
+    removable = True
+    intensity = "rho_pd"
+    neutral = {"rho_pd": 0.0}
 
     def lobe(self, ctx):
         geo = ctx.geometry
@@ -230,6 +244,8 @@ class Depolarization(Effect):
         "between facets: the lobe's S1, S2, S3 are scaled by 1 - d_spec, its intensity kept. Lowers the "
         "DOP of the specular lobe at every angle by the same factor."
     )
+    twins = {"extinction": "the full Mueller matrix (an analyser acts on the detector side only, depolarization on the light itself: M12 and M21 differ)"}
+    neutral = {"d_spec": 0.0}
 
     def modify_specular(self, ctx, lobe):
         d = ctx["d_spec"]
@@ -257,6 +273,15 @@ class Anisotropy(Effect):
         "turned by psi from the plane of incidence replace sigma. The specular lobe stretches along "
         "the rough axis, so out-of-plane data change with the sample's rotation."
     )
+    splits = {"sigma_x": "sigma", "sigma_y": "sigma"}
+
+    def identifiable(self, values):
+        """(sigma_x, sigma_y, psi) and (sigma_y, sigma_x, psi + 90), and psi and psi + 180, describe the same
+        surface: order the widths (sigma_x <= sigma_y) and take psi modulo 180 after the swap."""
+        sx, sy, psi = (np.asarray(values[n], float) for n in ("sigma_x", "sigma_y", "psi"))
+        swap = sx > sy
+        return {**values, "sigma_x": np.where(swap, sy, sx), "sigma_y": np.where(swap, sx, sy),
+                "psi": np.where(swap, psi + 90.0, psi) % 180.0}
 
     def configure(self, ctx):
         ctx.anisotropic_slopes = (ctx["sigma_x"], ctx["sigma_y"], ctx["psi"])
@@ -270,6 +295,7 @@ class GGX(Effect):
         "peak curvature, much longer tails, so more light far from the specular direction (and a "
         "smoother fall of DOP away from it)."
     )
+    slot = "facets"
 
     def configure(self, ctx):
         ctx.facet_shape = "ggx"
@@ -287,6 +313,13 @@ class OxideLayer(Effect):
         "of the film's two interfaces (Airy formula), so r_s and r_p, and hence DOP, oscillate with "
         "thickness/wavelength and angle. Needs the wavelength (metadata `wavelength_um` or a column)."
     )
+    neutral = {"thickness_um": 0.0}
+
+    def applicable(self, data):
+        wavelength = data.wavelength_um
+        if wavelength is None or np.any(~np.isfinite(wavelength)):
+            return "needs the wavelength (a '# wavelength_um: ...' line or a wavelength_um column)"
+        return None
 
     def configure(self, ctx):
         wavelength = ctx.geometry.wavelength_um
@@ -308,6 +341,7 @@ class AngleOffset(Effect):
         "A goniometer zero error: the true angles are theta_i + delta and theta_r + delta. Shifts the "
         "whole DOP curve along the angle axis (the geometry is then recomputed for each parameter set)."
     )
+    neutral = {"delta_deg": 0.0}
 
     def transform_geometry(self, params, geometry):
         return geometry.with_offset(params["delta_deg"])
@@ -325,6 +359,8 @@ class Extinction(Effect):
         "detector side, so the measured Mueller matrix is not reciprocal."
     )
     reciprocal = False
+    twins = {"depolarization": "the full Mueller matrix (an analyser acts on the detector side only, depolarization on the light itself: M12 and M21 differ)"}
+    neutral = {"e": 1.0}
 
     def modify_stokes(self, ctx, total):
         total[1:] *= ctx["e"]
@@ -342,13 +378,34 @@ class DopBias(Effect):
         "measured DOP only (the Stokes vector is the physical one); the estimate may exceed 1 by at most "
         "sqrt(1 + bias^2) - 1."
     )
+    neutral = {"bias": 0.0}
 
     def modify_dop(self, ctx, dop):
         return np.sqrt(dop**2 + ctx["bias"] ** 2)
 
 
+class Lambertian(Effect):
+    name = "lambertian"
+    parameters = (
+        Parameter("rho_l", "", Uniform(0.0, 1.0), 0.1, "albedo of the depolarized Lambertian diffuse light", physical=(0.0, 1.0)),
+    )
+    description = (
+        "Depolarized Lambertian diffuse reflection f = (rho_l/pi) diag(1,0,0,0): the same radiance in "
+        "every direction, reciprocal, energy-conserving for rho_l <= 1. The physical alternative to the "
+        "paper's `body` term, whose cos(theta_r) factor makes it neither Lambertian nor reciprocal; like "
+        "it, it lowers DOP wherever the specular lobe is weak."
+    )
+    slot = "body"
+    removable = True
+    intensity = "rho_l"
+    neutral = {"rho_l": 0.0}
+
+    def lobe(self, ctx):
+        return ctx.depolarized((ctx["rho_l"] / np.pi) * np.ones_like(ctx.geometry.cos_tr))
+
+
 BUILTIN_EFFECTS = (
     Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
-    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias,
+    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian,
 )
 PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

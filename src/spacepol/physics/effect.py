@@ -86,7 +86,27 @@ class DepolarizedLobe:
 
 
 class Effect:
-    """Base class of all effects.  Subclasses set the class attributes and override hooks."""
+    """Base class of all effects.  Subclasses set the class attributes and override hooks.
+
+    Besides its physics an effect carries what model criticism needs to know about it, so that a
+    plug-in takes part on equal terms with the built-ins (nothing in diagnose, the optimiser or the
+    identifiability report names an effect):
+
+    * ``slot``: the role it plays ("shadowing", "body", "facets"), or None for a pure addition;
+      effects of one slot can replace each other ("replace shadowing by smith");
+    * ``removable``: "remove E" is a sensible change (a shadowing term, a diffuse lobe);
+    * ``twins``: {other effect: the measurement that separates them} for effects that predict the
+      same thing on some data (both are then always refitted, and a tie is reported with it);
+    * ``neutral``: parameter values at which the effect changes nothing (where the optimiser starts
+      it when it is added to a fitted model);
+    * ``splits``: {own parameter: model parameter it refines} (anisotropy's sigma_x starts at sigma);
+    * ``branches``: parameter subsets worth a separate optimiser search (a dielectric's k = 0 is a
+      sliver of the k prior that a global search otherwise misses);
+    * ``intensity``: the parameter that scales this effect's lobe (DOP, a ratio of intensities,
+      measures only ratios of such parameters: the identifiability report says so);
+    * ``applicable(data)``: why the effect cannot be used with these data (None if it can);
+    * ``identifiable(values)``: the parameters in a form the data can identify (label swaps removed).
+    """
 
     name: str = ""
     parameters: tuple[Parameter, ...] = ()
@@ -95,6 +115,21 @@ class Effect:
     removes: tuple[str, ...] = ()  # parameters of other effects this one makes unused
     reciprocal: bool = True  # does it keep M(i -> r) = Q M(r -> i)^T Q ?
     description: str = ""
+    slot: str | None = None
+    removable: bool = False
+    twins: dict = {}
+    neutral: dict = {}
+    splits: dict = {}
+    branches: tuple = ()
+    intensity: str | None = None
+
+    def applicable(self, data) -> str | None:
+        """None when the effect can be used with ``data``; else the reason, in words."""
+        return None
+
+    def identifiable(self, values: dict) -> dict:
+        """{parameter: array} in a canonical form free of label swaps (default: as is)."""
+        return values
 
     # lmfit-style composition: effect + effect -> Model
     def __add__(self, other):
@@ -130,7 +165,8 @@ class Effect:
 _STAGES = {"lobe", "specular_factor", "modify_specular", "modify_stokes", "modify_dop"}
 
 
-def effect(name: str, *, stage: str, parameters=(), requires=(), description: str = "", reciprocal: bool = True):
+def effect(name: str, *, stage: str, parameters=(), requires=(), description: str = "", reciprocal: bool = True,
+           slot: str | None = None, removable: bool = False, twins=None, neutral=None):
     """Decorator that turns a function into an effect class.
 
     ``stage`` names the hook the function implements; it is called as ``fn(ctx, ...)`` with
@@ -157,6 +193,10 @@ def effect(name: str, *, stage: str, parameters=(), requires=(), description: st
             "requires": tuple(requires),
             "description": description or (fn.__doc__ or "").strip(),
             "reciprocal": reciprocal,
+            "slot": slot,
+            "removable": removable,
+            "twins": dict(twins or {}),
+            "neutral": dict(neutral or {}),
             stage: hook,
             "__module__": fn.__module__,
             "__doc__": fn.__doc__,

@@ -66,7 +66,8 @@ def ladder_figure(rungs, fig=None) -> Figure:
         fig.colorbar(scatter, ax=fig.axes[: len(rungs)], label="theta_i (deg)", shrink=0.8)
     ax = fig.add_subplot(grid[1, :])
     x = np.arange(len(rungs))
-    labels = [r["model"] if i == 0 else "+ " + r["model"].split("+")[-1] for i, r in enumerate(rungs)]
+    labels = [r["model"] if i == 0 else (r.get("change") or "+ " + r["model"].split("+")[-1]).replace(" by ", " by\n")
+              for i, r in enumerate(rungs)]
     ax.errorbar(x, [r["elpd_loo"] for r in rungs], yerr=[r["elpd_loo_se"] for r in rungs], fmt="s-", color="k",
                 label="ELPD-LOO +- SE (higher is better)")
     ax.set_ylabel("ELPD-LOO (solid)")

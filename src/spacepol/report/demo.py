@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from ..criticism.diagnose import diagnose
+from ..criticism.changes import parse
 from ..criticism.ladder import climb
+from ..errors import SpacepolError
 from ..infer.identifiability import bound_finding
 from ..infer.inversion import invert
 from ..io.atomic import write_json, write_text
@@ -82,10 +84,18 @@ def criticise(data, base, out: Path, label: str, seed: int, max_additions: int =
     base, confirmed = report.pop("_base"), report.pop("_confirmed")
     write_diagnose_report(report, base, confirmed, out / "diagnose", label)
     write_json(out / "diagnose.json", report)
-    additions = []
+    additions, current = [], model
     if report["verdict"] != "none":
         twins = set(report["ranking"][0].get("tied_with", []))
-        additions = [r["effect"] for r in report["ranking"] if r["significant"] and r["effect"] not in twins][:max_additions]
+        for r in report["ranking"]:
+            named = r["effect"] if r["change"] == f"add {r['effect']}" else r["change"]
+            if not r["significant"] or named in twins or len(additions) == max_additions:
+                continue
+            try:  # two significant changes may exclude each other (add lambertian, replace body by lambertian)
+                current = parse(current, r["change"]).model
+            except SpacepolError:
+                continue
+            additions.append(r["change"])
     fitted = {base.summary["model"]: base} | {c["inversion"].summary["model"]: c["inversion"] for c in confirmed}
     rungs = climb(data, model, additions, seed=seed, fitted=fitted)
     write_ladder_report(rungs, out / "ladder")

@@ -9,7 +9,8 @@ from ..infer.identifiability import bound_finding
 from ..io.atomic import atomic_path, save_figure
 from . import html as H
 from ..criticism.residuals import analyse
-from .criticism_figures import residual_trends_figure, signature_figure
+from .criticism_figures import ladder_figure, residual_trends_figure, signature_figure
+from .ladder_report import ladder_table
 from .inversion_figures import residual_figure
 
 
@@ -26,19 +27,30 @@ def ranking_rows(report: dict) -> list[list]:
     rows = []
     for r in report["ranking"]:
         confirmed = r["delta_elpd"] is not None
-        rows.append([r["effect"], f"{r['screening_gain']:+.1f}",
+        rows.append([r.get("change", r["effect"]), f"{r['screening_gain']:+.1f}",
                      f"{r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f}" if confirmed else "not refitted",
                      f"{r['rmse_dop_after']:.4f}" if confirmed and r["rmse_dop_after"] is not None else "",
                      ("yes" if r["significant"] else "no") + (f" (tied with {', '.join(r['tied_with'])})" if r.get("tied_with") else "")])
     return rows
 
 
+def _name(entry: dict) -> str:
+    """An addition by its effect's name (as before swaps existed), any other change in words."""
+    change = entry.get("change") or f"add {entry['effect']}"
+    return entry["effect"] if change == f"add {entry['effect']}" else change
+
+
+def figure_name(change_label: str) -> str:
+    words = change_label.split()
+    return f"residuals_{words[1]}.png" if words[0] == "add" else "residuals_" + "_".join(words) + ".png"
+
+
 def significance_statement(report: dict) -> str:
     """Which candidates improve ELPD-LOO by more than 2 SE and which do not, in one sentence."""
     confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]
-    yes = [f"{r['effect']} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if r["significant"]]
-    no = [f"{r['effect']} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if not r["significant"]]
-    screened = [r["effect"] for r in report["ranking"] if r["delta_elpd"] is None]
+    yes = [f"{_name(r)} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if r["significant"]]
+    no = [f"{_name(r)} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if not r["significant"]]
+    screened = [_name(r) for r in report["ranking"] if r["delta_elpd"] is None]
     text = ("Improve ELPD-LOO by more than 2 SE: " + (", ".join(yes) if yes else "none") + ". Do not: "
             + (", ".join(no) if no else "none of the refitted candidates"))
     if screened:
@@ -46,8 +58,10 @@ def significance_statement(report: dict) -> str:
     return text + "."
 
 
-def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, data_label: str) -> dict[str, Path]:
-    """Write the figures and report.html into ``out``; returns the figure paths."""
+def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, data_label: str,
+                          path_rungs: list[dict] | None = None) -> dict[str, Path]:
+    """Write the figures and report.html into ``out``; returns the figure paths. ``path_rungs``: the
+    rounds of `diagnose --rounds` as ladder rungs (a path section, ``path.png`` and ``path.md``)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     paths = {"base": out / "residuals_base.png", "signatures": out / "signatures.png"}
@@ -55,9 +69,9 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     paths["trends"] = out / "residual_trends_base.png"
     save_figure(residual_trends_figure(analyse(base.posterior, base.result.flat_samples())), paths["trends"])
     for c in confirmed:
-        paths[c["effect"]] = out / f"residuals_{c['effect']}.png"
-        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["effect"]])
-    save_figure(signature_figure(base, [(c["effect"], c["signatures"]) for c in confirmed]), paths["signatures"])
+        paths[c["change"]] = out / figure_name(c["change"])
+        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["change"]])
+    save_figure(signature_figure(base, [(_name(c), c["signatures"]) for c in confirmed]), paths["signatures"])
     fit = report["fit"]
     sections = [
         ("Data and base model", H.paragraph(
@@ -66,15 +80,31 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
          + H.bullets(report["residual_structure"] + pareto_warnings(base.summary)
                      + [bound_finding(f) for f in base.summary["identifiability"].get("at_bound", [])])),
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
-        ("Ranking", H.table(["effect", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
+        ("Ranking", H.table(["change", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
                              "significant (> 2 SE and > 4)"], ranking_rows(report))
-         + H.bullets([f"{r['effect']}: {r['explanation']}" for r in report["ranking"] if r["delta_elpd"] is not None])),
+         + H.bullets([f"{_name(r)}: {r['explanation']}" for r in report["ranking"] if r["delta_elpd"] is not None])),
         ("Signatures", H.image(H.png_file_to_data_uri(paths["signatures"]),
                                "Dots: residuals of the base fit / noise. Crosses: what each candidate changes in the "
                                "prediction, in the same units. A candidate that explains the misfit follows the dots.")),
         ("Residuals of the base fit", H.image(H.png_file_to_data_uri(paths["base"]))
          + H.image(H.png_file_to_data_uri(paths["trends"]), "The structure: residuals against each variable.")),
     ]
+    if path_rungs:
+        paths["path"] = out / "path.png"
+        save_figure(ladder_figure(path_rungs), paths["path"])
+        public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in path_rungs]
+        table = ladder_table(public)
+        with atomic_path(out / "path.md") as tmp:
+            tmp.write_text("\n".join(table) + "\n", encoding="utf-8")
+        rows = [[i, r["model"], r.get("change") or "(start)",
+                 "" if r.get("delta_elpd") is None else f"{r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f}",
+                 describe_fit({"fit": {"chi2_red": r["chi2_red"]},
+                               "parameters": {k: {"median": v} for k, v in r.get("inferred_noise", {}).items()}}),
+                 "structured" if r.get("structured") else "noise-like"] for i, r in enumerate(public)]
+        sections.insert(1, ("The path, round by round", H.paragraph(report.get("conclusion_rounds", ""))
+                            + H.table(["round", "model", "change", "delta ELPD-LOO +- SE", "fit", "residuals"], rows)
+                            + H.image(H.png_file_to_data_uri(paths["path"]),
+                                      "Residuals per round (top); ELPD-LOO and the error measure per round (bottom).")))
     with atomic_path(out / "report.html") as tmp:
         tmp.write_text(H.page(f"spacepol diagnose: what is missing from {report['model']}", sections), encoding="utf-8")
     return paths

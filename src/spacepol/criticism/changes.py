@@ -1,0 +1,138 @@
+"""The changes of a model that diagnose weighs: every addition of a registered effect, every
+replacement of a slot's member by another of the same slot ("replace shadowing by smith",
+"replace body by lambertian"), and every removal of an effect that declares itself removable.
+What an effect may do comes from the effect itself (``Effect.slot``, ``removable``, ``applicable``),
+so a plug-in takes part like a built-in."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SpacepolError
+from ..physics.model import Model
+from ..physics.registry import registry
+
+
+@dataclass
+class Change:
+    kind: str  # "add" | "replace" | "remove"
+    effect: str  # the effect added, the slot's new member, or the effect removed
+    model: Model  # the model after the change
+    replaced: str | None = None
+
+    @property
+    def label(self) -> str:
+        if self.kind == "replace":
+            return f"replace {self.replaced} by {self.effect}"
+        return f"{self.kind} {self.effect}"
+
+    @property
+    def verdict(self) -> str:
+        """What diagnose's ``verdict`` says: the effect's name for an addition (DESIGN's contract), the
+        change itself otherwise."""
+        return self.effect if self.kind == "add" else self.label
+
+
+def apply(model: Model, label: str) -> Model:
+    """The model after a change written as ``add E``, ``replace A by B`` or ``remove E``."""
+    words = label.split()
+    try:
+        if words[0] == "add" and len(words) == 2:
+            return model + words[1]
+        if words[0] == "remove" and len(words) == 2:
+            _index(model, words[1])
+            return Model([type(e) for e in model.effects if e.name != words[1]])
+        if words[0] == "replace" and len(words) == 4 and words[2] == "by":
+            i = _index(model, words[1])
+            classes = [type(e) for e in model.effects]
+            classes[i] = registry.get(words[3])
+            return Model(classes)
+    except IndexError:
+        pass
+    raise SpacepolError(f"change '{label}': write 'add E', 'replace A by B' or 'remove E'")
+
+
+def parse(model: Model, label: str) -> Change:
+    """``"add E"`` / ``"E"``, ``"replace A by B"`` or ``"remove E"`` applied to ``model``, as a Change."""
+    label = label.strip()
+    if " " not in label:
+        label = f"add {label}"
+    words = label.split()
+    new = apply(model, label)
+    if words[0] == "replace":
+        return Change("replace", words[3], new, replaced=words[1])
+    return Change(words[0], words[1], new)
+
+
+def _index(model: Model, name: str) -> int:
+    names = [e.name for e in model.effects]
+    if name not in names:
+        raise SpacepolError(f"change: '{name}' is not in model {model.name}")
+    return names.index(name)
+
+
+def changes(model: Model, data, names=None) -> list[Change]:
+    """Every change of ``model`` that composes and that the data allow; ``names`` restricts the
+    effects considered (added, brought in or removed)."""
+    present = [e.name for e in model.effects]
+    out: list[Change] = []
+    for name in names or registry.names():
+        if name in present:
+            continue
+        cls = registry.get(name)
+        if cls().applicable(data) is not None:
+            continue
+        for change in [("add", None)] + [("replace", e.name) for e in model.effects if cls.slot and e.slot == cls.slot]:
+            try:
+                label = f"add {name}" if change[0] == "add" else f"replace {change[1]} by {name}"
+                out.append(Change(change[0], name, apply(model, label), replaced=change[1]))
+            except SpacepolError:
+                continue  # does not compose (e.g. smith beside shadowing, ggx without specular)
+    for e in model.effects:
+        if e.removable and (names is None or e.name in names):
+            try:
+                out.append(Change("remove", e.name, apply(model, f"remove {e.name}")))
+            except SpacepolError:
+                continue  # another effect needs it
+    return out
+
+
+def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
+    """Where the optimiser starts the changed model: at the base model's optimum, the new effect's own
+    parameters at its ``neutral`` values (where it changes nothing), its default, the prior's ends and
+    middle; a parameter that refines one of the base model's (``splits``) at that value; and for a
+    replacement the new member's intensity at the old member's (a diffuse albedo carried over)."""
+    effect = registry.get(change.effect)
+    params = {p.name: p for p in change.model.parameters}
+    carried = {}
+    if change.kind == "replace":
+        old = registry.get(change.replaced)
+        if effect.intensity and old.intensity in base_best:
+            carried[effect.intensity] = base_best[old.intensity]
+    rows = []
+    for option in range(5):
+        row = []
+        for name in posterior.priors.names:
+            if name in base_best:
+                row.append(base_best[name])
+                continue
+            lo, hi = posterior.priors.priors[name].bounds
+            default = params[name].default if name in params else 0.5 * (lo + hi)
+            refined = effect.splits.get(name) if change.kind != "remove" else None
+            if refined in base_best:
+                row.append(base_best[refined])
+            elif option == 4 and name in carried:
+                row.append(carried[name])
+            else:
+                row.append([effect.neutral.get(name, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][option])
+        rows.append(row)
+    bounds = posterior.priors.bounds
+    return np.clip(np.array(rows, float), bounds[:, 0], bounds[:, 1])
+
+
+def separating_measurement(a: str, b: str) -> str | None:
+    """What separates two effects declared twins (by either of them), or None if neither declares it."""
+    ea, eb = registry.get(a), registry.get(b)
+    return ea.twins.get(b) or eb.twins.get(a)

@@ -1,0 +1,85 @@
+"""diagnose --rounds N: accept the best significant change, continue from the changed model, stop when
+no change is significant (or after N rounds).  The path records, per round, the model, the change, its
+delta ELPD +- SE, the fit (reduced chi^2 with known noise; the inferred noise level otherwise) and the
+residual structure, so a user sees the error fall round by round and whether the end is noise."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from ..infer.diagnostics import describe_fit, inferred_noise_levels
+from ..physics.model import Model
+from .diagnose import _structured, diagnose
+
+
+def _step(summary: dict, change=None, delta=None, se=None) -> dict:
+    return {"model": summary["model"], "change": change, "delta_elpd": delta, "delta_elpd_se": se,
+            "fit": summary["fit"], "inferred_noise": inferred_noise_levels(summary),
+            "residual_structure": summary["residual_structure"]["findings"],
+            "structured": bool(_structured(summary)), "at_bound": summary["identifiability"].get("at_bound", [])}
+
+
+def as_rungs(result: dict) -> list[dict]:
+    """The path as ladder rungs (for the ladder figure and table), with each round's Inversion."""
+    inversions = [result["_reports"][0]["_base"]]
+    for report, step in zip(result["_reports"], result["rounds"][1:]):
+        inversions.append(next(c["inversion"] for c in report["_confirmed"] if c["change"] == step["change"]))
+    rungs = []
+    for step, inv in zip(result["rounds"], inversions):
+        fit = step["fit"]
+        rungs.append({"model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
+                      "delta_elpd_se": step["delta_elpd_se"], "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
+                      "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"], "inferred_noise": step["inferred_noise"],
+                      "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
+                      "at_bound": step["at_bound"], "_inversion": inv})
+    return rungs
+
+
+def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, seed: int = 0, observables=None,
+                    candidates=None, top: int = 3, progress: bool = True, priors: dict | None = None, base=None) -> dict:
+    """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
+    ``conclusion`` over the whole path; ``_reports`` keeps each round's full report."""
+    reports, current = [], model
+    path = []
+    for r in range(rounds):
+        if progress:
+            print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
+        report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
+                          progress=progress, priors=priors, base=base)
+        reports.append(report)
+        if not path:
+            path.append(_step(report["_base"].summary))
+        if report["verdict"] == "none":
+            break
+        lead = next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
+        path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"]))
+        current, base = lead["_change"].model, lead["inversion"]
+        if progress:
+            print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "
+                  f"{describe_fit(lead['inversion'].summary)}", file=sys.stderr, flush=True)
+    first = {k: v for k, v in reports[0].items() if not k.startswith("_")}
+    out = {**first, "rounds": path, "final_model": current.name, "conclusion_rounds": _conclusion(path, reports)}
+    out["_reports"] = reports
+    return out
+
+
+def _conclusion(path: list[dict], reports: list[dict]) -> str:
+    final = path[-1]
+    changes = [p["change"] for p in path[1:]]
+    route = " -> ".join([path[0]["model"]] + changes) if changes else path[0]["model"]
+    stopped = ("no further change is significant" if reports[-1]["verdict"] == "none"
+               else f"the round limit was reached ({len(reports)})")
+    if not changes:
+        text = f"No change of {path[0]['model']} improves ELPD-LOO by more than 2 SE (and 4)."
+    else:
+        text = f"Path: {route}; {stopped}."
+    fit = describe_fit({"fit": final["fit"], "parameters": {k: {"median": v} for k, v in final["inferred_noise"].items()}})
+    if final["structured"]:
+        text += (f" Partly explained: the final model {final['model']} still leaves structured residuals ({fit}; "
+                 + " ".join(final["residual_structure"]) + "). The structure that remains points to an effect the library "
+                 "does not have (or one the rounds did not reach).")
+    else:
+        text += f" Explained: the residuals of the final model {final['model']} look like noise ({fit})."
+    return text

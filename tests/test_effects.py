@@ -193,3 +193,22 @@ def test_dop_bias_is_rician_on_average():
     biased = ev("paper+dop_bias", {**PAPER, "bias": 0.05}, g)
     np.testing.assert_allclose(biased.dop, np.sqrt(base.dop**2 + 0.05**2), rtol=1e-12)
     assert np.all(biased.dop > base.dop)
+
+
+def test_lambertian_reflects_its_albedo_and_is_unpolarized():
+    """Directional-hemispherical reflectance of rho_l/pi is rho_l at every incidence (quadrature over the
+    hemisphere, independent of the model code); its light is unpolarized (S1 = S2 = 0 alone)."""
+    import numpy as np
+
+    from spacepol.physics import Geometry, Model
+
+    model = Model.from_string("lambertian")
+    tr, dphi = np.meshgrid(np.linspace(0.0, 89.9, 400), np.linspace(-180.0, 180.0, 181), indexing="ij")
+    for ti in (0.0, 40.0, 80.0):
+        g = Geometry(np.full(tr.size, ti), tr.ravel(), dphi.ravel())
+        pred = model.evaluate({"rho_l": 0.37}, g)
+        f = pred.brdf.reshape(tr.shape)
+        integrand = f * np.cos(np.radians(tr)) * np.sin(np.radians(tr))
+        albedo = np.trapezoid(np.trapezoid(integrand, np.radians(dphi[0]), axis=1), np.radians(tr[:, 0]))
+        assert abs(albedo - 0.37) < 2e-3, (ti, albedo)
+        assert np.all(pred.stokes[1:] == 0)

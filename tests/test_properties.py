@@ -10,7 +10,7 @@ from spacepol.physics.effects import registry
 # Two models that between them hold every built-in effect once.
 MODELS = [
     "specular+shadowing+body+polarized_diffuse+depolarization+oxide_layer+angle_offset+extinction+dop_bias",
-    "specular+smith+ggx+anisotropy+body+polarized_diffuse",
+    "specular+smith+ggx+anisotropy+body+polarized_diffuse+lambertian",
     # these two take the compiled Stokes kernel (isotropic facets, bulk Fresnel, fixed geometry)
     "specular+shadowing+body+polarized_diffuse+depolarization+extinction+dop_bias",
     "specular+smith+ggx+body",
@@ -119,7 +119,7 @@ def _reciprocity_error(spec, rng):
 
 RECIPROCAL = ["specular", "specular+shadowing", "specular+smith", "specular+polarized_diffuse",
               "specular+depolarization", "specular+anisotropy", "specular+ggx+smith", "specular+oxide_layer",
-              "specular+angle_offset"]
+              "specular+angle_offset", "specular+lambertian"]
 
 
 @pytest.mark.parametrize("spec", RECIPROCAL)

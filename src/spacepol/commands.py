@@ -115,6 +115,10 @@ def effects(args) -> int:
             extras.append("replaces " + ", ".join(cls.excludes))
         if cls.removes:
             extras.append("replaces parameter " + ", ".join(cls.removes))
+        if cls.slot:
+            extras.append(f"slot {cls.slot}" + (" (removable)" if cls.removable else ""))
+        for twin, separation in cls.twins.items():
+            extras.append(f"twin of {twin} (separated by {separation})")
         extras.append("reciprocal" if cls.reciprocal else "NOT reciprocal")
         print(f"    ({'; '.join(extras)})")
         print()

@@ -123,8 +123,6 @@ def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
             refined = effect.splits.get(name) if change.kind != "remove" else None
             if refined in base_best:
                 row.append(base_best[refined])
-            elif option == 4 and name in carried:
-                row.append(carried[name])
             else:
                 row.append([effect.neutral.get(name, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][option])
         rows.append(row)

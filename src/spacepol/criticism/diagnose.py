@@ -1,4 +1,4 @@
-"""Which physical effect is missing: screen every registered effect, confirm the leaders.
+"""What is missing or wrong in a model: screen every change (add, replace, remove), confirm the leaders.
 
 1. Fit the model M (emcee) and keep its pointwise PSIS-LOO.
 2. Screening: for every change of M (``criticism.changes``: each registered effect added, each
@@ -31,6 +31,7 @@ from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
 from .changes import changes, separating_measurement, start_points
+
 
 def _first_sentence(text: str) -> str:
     return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."

@@ -9,10 +9,11 @@ E=examples/tutorial_user_effect/sheen.py:Sheen
 mkdir -p "$OUT"
 # 1. the new effect is registered like a built-in one
 invert-mcmc effects --effect $E | grep -A3 "^sheen"
-# 2. hide it in synthetic data: the paper's model plus sheen, DOP noise 0.003, BRDF noise 2 %
-invert-mcmc synth --effect $E --model paper+sheen --set n=1.5 --set k=0 --set sigma=0.2 --set ks=0.5 \
+# 2. hide it in synthetic data: a surface with physical (Smith) shadowing and the sheen; DOP noise 0.003, BRDF 2 %
+invert-mcmc synth --effect $E --model specular+smith+body+sheen --set n=1.5 --set k=0 --set sigma=0.2 --set ks=0.5 \
     --set rho_d=0.2 --set b_sheen=0.15 --noise-dop 0.003 --noise-brdf 0.02 --seed 7 --out "$OUT/sheen_hidden.csv"
-# 3. fit the paper's model and ask what is missing (every registered effect, built-in or not)
-invert-mcmc diagnose "$OUT/sheen_hidden.csv" --effect $E --model paper --json "$OUT/diagnose.json" --out "$OUT/diagnose"
-# 4. add it and watch the error fall
-invert-mcmc ladder "$OUT/sheen_hidden.csv" --effect $E --model paper --add sheen --json "$OUT/ladder.json" --out "$OUT/ladder"
+# 3. start from the paper's model and let diagnose change it, round by round, until nothing significant is left
+#    (every registered effect, built-in or not: additions, replacements of a slot's member, removals)
+invert-mcmc diagnose "$OUT/sheen_hidden.csv" --effect $E --model paper --rounds 3 --json "$OUT/diagnose.json" --out "$OUT/diagnose"
+# 4. replay the path as a ladder and watch the error fall at each round
+invert-mcmc ladder "$OUT/sheen_hidden.csv" --effect $E --model paper --replay "$OUT/diagnose.json" --json "$OUT/ladder.json" --out "$OUT/ladder"

@@ -85,9 +85,11 @@ def judge(kind, report) -> dict:
 
         twins = set(registry.get(expected).twins)
         effect_ok = any(a == expected or a in twins for a in additions) or any(expected in c for c in path)
-    return {"kind": kind, "path": path, "final_chi2": final_chi2, "swap": "replace shadowing by smith" in path,
-            "effect_ok": effect_ok, "ok": final_chi2 < 1.5 and "replace shadowing by smith" in path and effect_ok,
-            "tied": sorted(tied)}
+    # the shadowing swap, or a change of the shadowing slot that the data could not tell from it (a tie)
+    swap = "replace shadowing by smith" in path or any(
+        "shadowing" in (r["change"] or "") and "replace shadowing by smith" in r.get("tied_with", []) for r in report["rounds"])
+    return {"kind": kind, "path": path, "final_chi2": final_chi2, "swap": swap,
+            "effect_ok": effect_ok, "ok": final_chi2 < 1.5 and swap and effect_ok, "tied": sorted(tied)}
 
 
 @pytest.mark.slow

@@ -60,3 +60,17 @@ def test_identifiability_never_calls_a_flagged_parameter_well_constrained():
     findings = identifiability(post, result)["findings"]
     assert any("sits at its lower bound" in f for f in findings)
     assert not any("well constrained" in f for f in findings)
+
+
+def test_the_ladder_table_shows_the_inferred_noise_when_the_file_gives_none():
+    """With inferred noise chi^2 ~ 1 by construction: the table shows the inferred noise per rung and says why."""
+    from spacepol.report.ladder_report import ladder_table
+
+    rungs = [{"model": m, "rmse_dop": 0.01, "chi2_red": 1.0, "elpd_loo": e, "elpd_loo_se": 1.0, "rhat_max": 1.0,
+              "inferred_noise": {"sigma_dop": s, "sigma_brdf_rel": b}} for m, e, s, b in
+             [("paper", 384.4, 0.0083, 0.19), ("paper+polarized_diffuse", 473.9, 0.0167, 0.039)]]
+    text = "\n".join(ladder_table(rungs))
+    assert "sigma_dop (inferred)" in text and "sigma_brdf_rel (inferred)" in text and "0.039" in text
+    assert "by construction" in text
+    known = [{k: v for k, v in r.items() if k != "inferred_noise"} for r in rungs]  # control: known noise
+    assert "inferred" not in "\n".join(ladder_table(known))

@@ -97,6 +97,11 @@ def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     # and the residuals say the misfit is smooth: the BRDF's U shape (the body term's cos(theta_r))
     assert s["residual_structure"]["runs"]["brdf"]["p"] < 0.01
     assert "model that is wrong" in (out / "report.html").read_text()
+    # n piles against its prior bound 0.1: flagged, and never called well constrained (issue 9)
+    flags = s["identifiability"]["at_bound"]
+    assert any(f["parameter"] == "n" and f["side"] == "lower" for f in flags), flags
+    assert "n sits at its lower bound 0.1" in (out / "report.html").read_text()
+    assert not any("well constrained" in f for f in s["identifiability"]["findings"])
 
 
 def test_optimize_prints_json():

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 
+from ..infer.diagnostics import inferred_noise_levels
 from ..infer.inversion import invert
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
@@ -35,23 +36,13 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                 seeds = start_points(rungs[-1]["_inversion"].summary["map"], change, post)
                 centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
             inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
-        fit = inv.summary["fit"]
+        fit, noise = inv.summary["fit"], inferred_noise_levels(inv.summary)
         rungs.append({"model": current.name, "change": None if change is None else change.label,
                       "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
-                      "inferred_noise": inferred_noise(inv), "noise_known": not inferred_noise(inv),
+                      "inferred_noise": noise, "noise_known": not noise,
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"], "parameters": inv.summary["parameters"],
                       "at_bound": inv.summary["identifiability"].get("at_bound", []),
                       "residual_structure": inv.summary["residual_structure"]["findings"],
                       "_inversion": inv})
     return rungs
-
-
-def inferred_noise(inv) -> dict[str, float]:
-    """{nuisance name: posterior median} for each observable whose noise the fit inferred.
-
-    With inferred noise the reduced chi^2 is ~1 by construction: the noise parameter grows to
-    absorb whatever the model misses.  That inferred level is then the error that falls."""
-    lik = inv.posterior.likelihood
-    names = [lik.noise_parameter(o) for o in lik.observables]
-    return {n: inv.summary["parameters"][n]["median"] for n in dict.fromkeys(names) if n is not None}

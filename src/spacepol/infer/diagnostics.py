@@ -68,10 +68,14 @@ def inferred_noise_levels(summary: dict) -> dict[str, float]:
     return {n: summary["parameters"][n]["median"] for n in NUISANCE_NOISE if n in summary.get("parameters", {})}
 
 
-def describe_fit(summary: dict) -> str:
-    """The error measure that means something for this fit: reduced chi^2 with known noise; with
+def fit_words(chi2_red: float, noise: dict[str, float]) -> str:
+    """The error measure that means something for a fit: reduced chi^2 with known noise; with
     inferred noise (chi^2 ~ 1 by construction) the inferred noise levels."""
-    noise = inferred_noise_levels(summary)
     if noise:
         return "inferred noise " + ", ".join(f"{k} {v:.3g}" for k, v in noise.items())
-    return f"reduced chi^2 {summary['fit']['chi2_red']:.2f}"
+    return f"reduced chi^2 {chi2_red:.2f}"
+
+
+def describe_fit(summary: dict) -> str:
+    """``fit_words`` of a run's summary."""
+    return fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..infer.diagnostics import describe_fit
+from ..infer.diagnostics import describe_fit, fit_words
 from ..infer.identifiability import bound_finding
 from ..io.atomic import atomic_path, save_figure
 from . import html as H
@@ -98,8 +98,7 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
             tmp.write_text("\n".join(table) + "\n", encoding="utf-8")
         rows = [[i, r["model"], r.get("change") or "(start)",
                  "" if r.get("delta_elpd") is None else f"{r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f}",
-                 describe_fit({"fit": {"chi2_red": r["chi2_red"]},
-                               "parameters": {k: {"median": v} for k, v in r.get("inferred_noise", {}).items()}}),
+                 fit_words(r["chi2_red"], r.get("inferred_noise", {})),
                  "structured" if r.get("structured") else "noise-like"] for i, r in enumerate(public)]
         sections.insert(1, ("The path, round by round", H.paragraph(report.get("conclusion_rounds", ""))
                             + H.table(["round", "model", "change", "delta ELPD-LOO +- SE", "fit", "residuals"], rows)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .engines.de import run_de
+from . import local_search
 from .objective import NegativeLogPosterior
 from .posterior import Posterior
 from .priors import Fixed
@@ -58,7 +59,6 @@ def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: in
 
 def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 8192, polish: int = 8) -> tuple[float, np.ndarray]:
     """Best of ``polish`` L-BFGS-B runs started at the best of ``points`` Sobol points in the prior cube."""
-    from scipy.optimize import minimize
     from scipy.stats import qmc
 
     objective, priors = NegativeLogPosterior(posterior), posterior.priors
@@ -71,8 +71,8 @@ def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 819
     starts = u[np.argsort(values)[:polish]]
     best_value, best_u = np.inf, starts[0]
     for start in starts:
-        res = minimize(lambda x: float(f(x[None, :])[0]), start, method="L-BFGS-B", bounds=[(0.0, 1.0)] * priors.ndim)
-        if res.fun < best_value:
-            best_value, best_u = float(res.fun), np.clip(res.x, 0.0, 1.0)
+        value, u = local_search.polish(f, start)
+        if value < best_value:
+            best_value, best_u = value, u
     theta = priors.rescale(best_u[None, :])[0]
     return float(posterior.log_prob(theta[None, :])[0]), theta

@@ -7,6 +7,7 @@ import time
 import numpy as np
 from scipy.optimize import differential_evolution
 
+from .. import local_search
 from ..result import History, Result
 
 
@@ -41,13 +42,6 @@ def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evalua
     )
     best_u = np.clip(res.x, 0, 1)
     if polish:
-        from scipy.optimize import minimize
-
-        def scalar(u):
-            return float(f(np.clip(u, 0, 1)[:, None])[0])
-
-        local = minimize(scalar, best_u, method="L-BFGS-B", bounds=[(0.0, 1.0)] * ndim)
-        best_u = np.clip(local.x, 0, 1)
-        f(best_u[:, None])
+        _, best_u = local_search.polish(lambda rows: f(rows.T), best_u)
     return history.to_result("de", objective, model_name, time.perf_counter() - start, seed,
                              {"message": str(res.message), "iterations": int(res.nit)})

@@ -1,0 +1,38 @@
+"""Local polishing in the prior's unit cube: L-BFGS-B with a batched finite-difference gradient.
+
+scipy's own finite differences call the objective once per parameter, each call a separate model
+evaluation of one parameter set; the model is vectorised over parameter sets, so evaluating the point
+and its D neighbours as one batch of D + 1 rows costs about as much as one row (measured on the paper
+model, 84 points: 1 row 52 us, 8 rows 65 us). Forward differences with scipy's step (sqrt of machine
+epsilon), taken backwards at the upper bound.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize
+
+_STEP = np.sqrt(np.finfo(float).eps)
+
+
+def value_and_gradient(f, u: np.ndarray) -> tuple[float, np.ndarray]:
+    """f(u) and its forward-difference gradient from one call of the batched ``f`` ((R, D) -> (R,))."""
+    d = u.size
+    step = np.where(u + _STEP <= 1.0, _STEP, -_STEP)
+    rows = np.repeat(u[None, :], d + 1, axis=0)
+    rows[1:] += np.diag(step)
+    values = np.asarray(f(rows), float)
+    value = float(values[0])
+    if not np.isfinite(value):
+        return value, np.zeros(d)
+    grad = (values[1:] - value) / step
+    return value, np.where(np.isfinite(grad), grad, 0.0)
+
+
+def polish(f, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np.ndarray]:
+    """The local minimum of the batched ``f`` on [0, 1]^D nearest ``start``: (value, u)."""
+    start = np.clip(np.asarray(start, float), 0.0, 1.0)
+    res = minimize(lambda u: value_and_gradient(f, np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
+                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
+    u = np.clip(res.x, 0.0, 1.0)
+    return float(f(u[None, :])[0]), u

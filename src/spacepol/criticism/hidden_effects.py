@@ -186,10 +186,10 @@ def summarise(rows: list[dict], threshold: float = 3.0) -> dict:
     }
 
 
-def detection_figure(rows: list[dict], threshold: float = 3.0, fig=None) -> Figure:
+def detection_figure(rows: list[dict], threshold: float = 3.0, fig=None, ax=None) -> Figure:
     """Named (1) or not (0) against effect size / noise, one marker per effect; nulls at the left."""
-    fig = fig or Figure(figsize=(7.5, 4.0), layout="constrained")
-    ax = fig.add_subplot()
+    fig = ax.figure if ax is not None else (fig or Figure(figsize=(7.5, 4.0), layout="constrained"))
+    ax = ax or fig.add_subplot()
     effects = sorted({r["effect"] for r in rows if r["effect"] != "none"})
     for i, effect in enumerate(effects):
         sel = [r for r in rows if r["effect"] == effect]

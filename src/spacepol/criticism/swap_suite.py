@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from ..io.measurements import Dataset
 from ..physics.model import Model
@@ -86,10 +87,41 @@ def score(case: SwapCase, result: dict) -> dict:
             any(case.effect in c for c in path)
     return {"label": case.label, "effect": case.effect or "none", "material": case.material, "sampling": case.sampling,
             "noise_dop": case.noise[0], "path": path, "final_model": result["final_model"],
-            "chi2_red_final": final["fit"]["chi2_red"], "shadowing_swap": "replace shadowing by smith" in path,
+            "chi2_red_final": final["fit"]["chi2_red"],
+            "chi2_red_per_round": [r["fit"]["chi2_red"] for r in result["rounds"]], "shadowing_swap": "replace shadowing by smith" in path,
             "diffuse_change": any(c in DIFFUSE_CHANGES for c in path), "effect_ok": bool(effect_ok),
             "noise_like": final["fit"]["chi2_red"] < 1.5,
             "correct": bool("replace shadowing by smith" in path and effect_ok and final["fit"]["chi2_red"] < 1.5)}
+
+
+def summarise_swaps(rows: list[dict]) -> dict:
+    """Rates over the swap cases: right path and noise-like end; no spurious addition on the nulls."""
+    nulls = [r for r in rows if r["effect"] == "none"]
+    return {"n_swap": len(rows), "swap_correct_rate": float(np.mean([r["correct"] for r in rows])) if rows else None,
+            "swap_noise_like_rate": float(np.mean([r["noise_like"] for r in rows])) if rows else None,
+            "swap_shadowing_swap_rate": float(np.mean([r["shadowing_swap"] for r in rows])) if rows else None,
+            "n_swap_null": len(nulls), "swap_null_clean_rate": float(np.mean([r["effect_ok"] for r in nulls])) if nulls else None}
+
+
+def swap_figure(rows: list[dict], ax=None) -> Figure:
+    """Reduced chi^2 per round along each swap case's path (log scale): the error falls round by round
+    to the noise level (1) where the path is right."""
+    fig = ax.figure if ax is not None else Figure(figsize=(6.0, 4.0), layout="constrained")
+    ax = ax or fig.add_subplot()
+    effects = sorted({r["effect"] for r in rows})
+    for r in rows:
+        i = effects.index(r["effect"])
+        chi2 = r["chi2_red_per_round"]
+        ax.plot(range(len(chi2)), chi2, marker="os^vD<>p*"[i % 9], color=f"C{i}", ls="-" if r["correct"] else ":",
+                lw=1.0, label=r["effect"] if r is next(x for x in rows if x["effect"] == r["effect"]) else None)
+    ax.axhline(1.0, color="k", lw=0.6)
+    ax.axhline(1.5, color="k", ls=":", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel("round (0 = the paper's model)")
+    ax.set_ylabel("reduced chi^2 (known noise)")
+    ax.legend(fontsize=7, title="hidden effect (dotted: wrong path)", title_fontsize=7)
+    ax.set_title("diagnose --rounds from paper on specular+smith+lambertian+E", fontsize=9)
+    return fig
 
 
 def run_swap_case(case: SwapCase, rounds: int = 4, seed: int = 0, progress: bool = False) -> dict:

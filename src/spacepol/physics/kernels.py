@@ -2,7 +2,7 @@
 
 They compute exactly what the numpy code in ``fresnel``, ``facets`` and ``builtin_effects``
 computes (tests compare them), but in one pass over (parameter sets x geometries) with the
-geometry terms precomputed, across all cores.  Used for the Stokes path of the isotropic
+geometry terms precomputed.  Used for the Stokes path of the isotropic
 specular lobe with bulk Fresnel reflection, and for DOP from Stokes vectors.
 """
 
@@ -26,7 +26,7 @@ def _specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac
     n_sets = n.shape[0]
     n_geo = cos_b.shape[0]
     factor_stride = 1 if factor.shape[0] > 1 else 0
-    for p in numba.prange(n_sets):
+    for p in range(n_sets):
         nn, kk = n[p], k[p]
         var = sigma[p] * sigma[p]
         a2 = 2.0 * var
@@ -68,7 +68,7 @@ def _specular_stokes(n, k, sigma, ks, cos_b, sin2_b, sin_tan_b, tan2_a, sec4_jac
 def _stokes_dop(stokes, out):
     """DOP = |S_pol| / S0 (0 where S0 = 0), clipped at 1 against rounding; stokes (4, P, N)."""
     n_sets, n_geo = stokes.shape[1], stokes.shape[2]
-    for p in numba.prange(n_sets):
+    for p in range(n_sets):
         for j in range(n_geo):
             s0 = stokes[0, p, j]
             if s0 > 0.0:
@@ -78,24 +78,20 @@ def _stokes_dop(stokes, out):
                 out[p, j] = 0.0
 
 
-# Each kernel compiled twice: threads pay off on large batches (a benchmark's 4096 parameter
-# sets), but their start-up costs more than the work on an MCMC step's few walkers.
-PARALLEL_THRESHOLD = 16384  # elements (parameter sets x geometries)
-_specular_parallel = numba.njit(parallel=True, cache=True)(_specular_stokes)
+# One serial compilation each. (A parallel twin of each kernel was dropped: numba's on-disk cache keys
+# a function by name and line, not by its ``parallel`` flag, so both dispatchers loaded whichever was
+# compiled first; MCMC steps of 16 walkers then forked OpenMP threads, 10x slower on a loaded 2-core
+# machine. Large batches are issue 12's compiled path.)
 _specular_serial = numba.njit(cache=True)(_specular_stokes)
-_dop_parallel = numba.njit(parallel=True, cache=True)(_stokes_dop)
 _dop_serial = numba.njit(cache=True)(_stokes_dop)
 
 
 def specular_stokes(n, k, sigma, ks, *rest):
-    out = rest[-1]
-    kernel = _specular_parallel if out.shape[1] * out.shape[2] >= PARALLEL_THRESHOLD else _specular_serial
-    kernel(n, k, sigma, ks, *rest)
+    _specular_serial(n, k, sigma, ks, *rest)
 
 
 def stokes_dop(stokes, out):
-    kernel = _dop_parallel if out.size >= PARALLEL_THRESHOLD else _dop_serial
-    kernel(stokes, out)
+    _dop_serial(stokes, out)
 
 
 def as_sets(value, n_sets):

@@ -120,3 +120,19 @@ def residual_trends_figure(structure, fig=None) -> Figure:
                 ax.set_ylabel(f"{o} residual / noise", fontsize=8)
     fig.suptitle("Residual trends: a physical effect shows as a trend, noise does not", fontsize=9)
     return fig
+
+
+def validation_figure(rows: list[dict], swap_rows: list[dict]) -> Figure:
+    """The validation suite in one picture: detection against effect size (additions to the right base
+    model) and, where swap cases ran, reduced chi^2 along each diagnose --rounds path from paper."""
+    from ..criticism.hidden_effects import detection_figure
+    from ..criticism.swap_suite import swap_figure
+
+    panels = int(bool(rows)) + int(bool(swap_rows))
+    fig = Figure(figsize=(7.0 * max(panels, 1), 4.2), layout="constrained")
+    axes = fig.subplots(1, max(panels, 1), squeeze=False)[0]
+    if rows:
+        detection_figure(rows, ax=axes[0])
+    if swap_rows:
+        swap_figure(swap_rows, ax=axes[-1])
+    return fig

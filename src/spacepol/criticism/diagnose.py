@@ -233,14 +233,29 @@ def _conclusion(base, confirmed, verdict) -> str:
     return text
 
 
+SAME_MISFIT = 0.8
+
+
 def _tied(a, b) -> bool:
-    """Equal predictive performance within noise: neither is significantly better than the other by the
-    rule of ``significant`` (|delta ELPD| <= 2 SE of the difference, or <= 4: exact twins differ by
-    sampling noise only, small in absolute terms but not in SE units; Sivula, Magnusson & Vehtari 2020).
-    (A 1-SE rule split near-equals: on a rough dielectric render 'remove shadowing' +1202.5 and
-    'replace shadowing by smith' +1198.1 came out as a confident choice between them.)"""
+    """Two explanations of the same misfit that the data cannot tell apart: their signatures (what each
+    changes in the prediction, in noise units) correlate >= 0.8, and neither is significantly better by
+    the rule of ``significant`` (|delta ELPD| <= 2 SE of the difference, or <= 4; exact twins differ by
+    sampling noise only; Sivula, Magnusson & Vehtari 2020). Changes that fix different parts of the
+    misfit are not alternatives (the rounds take both), however close their ELPD.
+    (A 1-SE rule without the signature split near-equals: on a rough dielectric render 'remove shadowing'
+    +1202.5 and 'replace shadowing by smith' +1198.1 came out as a confident choice between them; a 2-SE
+    rule alone tied 'remove shadowing' with 'add depolarization', which mend different misfits.)"""
     diff = a["pointwise"] - b["pointwise"]
-    return not significant(abs(float(diff.sum())), float(np.sqrt(len(diff) * np.var(diff))))
+    return (_signature_correlation(a, b) >= SAME_MISFIT
+            and not significant(abs(float(diff.sum())), float(np.sqrt(len(diff) * np.var(diff)))))
+
+
+def _signature_correlation(a, b) -> float:
+    sa = np.concatenate([a["signatures"][o]["signature"] for o in sorted(a["signatures"])])
+    sb = np.concatenate([b["signatures"][o]["signature"] for o in sorted(b["signatures"])])
+    if np.std(sa) == 0 or np.std(sb) == 0:
+        return 1.0 if np.std(sa) == np.std(sb) else 0.0
+    return float(np.corrcoef(sa, sb)[0, 1])
 
 
 def _explain(c, base) -> str:

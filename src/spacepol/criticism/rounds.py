@@ -14,8 +14,9 @@ from ..physics.model import Model
 from .diagnose import _structured, diagnose
 
 
-def _step(summary: dict, change=None, delta=None, se=None, tied=()) -> dict:
+def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
     return {"model": summary["model"], "change": change, "delta_elpd": delta, "delta_elpd_se": se, "tied_with": list(tied),
+            "alternatives": list(alternatives),
             "fit": summary["fit"], "inferred_noise": inferred_noise_levels(summary),
             "residual_structure": summary["residual_structure"]["findings"],
             "structured": bool(_structured(summary)), "at_bound": summary["identifiability"].get("at_bound", [])}
@@ -54,8 +55,11 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
         if report["verdict"] == "none":
             break
         lead = next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
+        # the other changes refitted in this round, so the path shows what the chosen one was weighed against
+        alternatives = [{k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se", "significant")}
+                        for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead["change"]]
         path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"],
-                          report["ranking"][0].get("tied_with", [])))
+                          report["ranking"][0].get("tied_with", []), alternatives))
         current, base = lead["_change"].model, lead["inversion"]
         if progress:
             print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "

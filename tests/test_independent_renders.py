@@ -88,10 +88,12 @@ def judge(kind, report) -> dict:
         twins = set(registry.get(expected).twins)
         effect_ok = any(a == expected or a in twins for a in additions) or any(expected in c for c in path)
     # the shadowing swap: the final model's shadowing slot holds smith (swapped in one round, or removed and
-    # added back later), or a shadowing-slot change the data could not tell from the swap (a tie)
+    # added back later), or a shadowing-slot change the data could not tell from the swap (a tie), or the
+    # final model's shadowing slot is one the data cannot tell from smith (an equivalent at the end)
     final = report["final_model"].split("+")
     swap = ("smith" in final and "shadowing" not in final) or any(
-        "shadowing" in (r["change"] or "") and "replace shadowing by smith" in r.get("tied_with", []) for r in report["rounds"])
+        "shadowing" in (r["change"] or "") and "replace shadowing by smith" in r.get("tied_with", []) for r in report["rounds"]) \
+        or ("shadowing" not in final and any(e["change"].endswith("smith") for e in report["rounds"][-1].get("equivalent", [])))
     return {"kind": kind, "path": path, "final_chi2": final_chi2, "swap": swap,
             "effect_ok": effect_ok, "ok": final_chi2 < 1.5 and swap and effect_ok, "tied": sorted(tied)}
 

@@ -109,6 +109,23 @@ def test_a_plugin_declaring_twins_is_reported_as_tied(plugins, tmp_path):
     assert sum(r["delta_elpd"] is not None for r in report["ranking"]) == 2
 
 
+def test_slot_alternatives_are_the_other_members_of_the_slots_the_path_changed():
+    """What the end of a path is weighed against: the other members of each changed slot, filling an
+    emptied slot, or emptying it; never an unrelated addition. slot_of names the slot a change acted on."""
+    from spacepol.criticism.changes import slot_alternatives, slot_of
+
+    data = Dataset(np.array([30.0]), np.array([30.0]), np.array([180.0]))
+    emptied = slot_alternatives(Model.from_string("specular+body"), data, {"shadowing"})
+    assert {"add smith", "add shadowing"} <= set(emptied) and not any("body" in c or "dop_bias" in c for c in emptied)
+    both = set(slot_alternatives(Model.from_string("specular+smith+lambertian"), data, {"shadowing", "body"}))
+    assert {"replace smith by shadowing", "remove smith", "replace lambertian by body",
+            "replace lambertian by polarized_diffuse", "remove lambertian"} <= both
+    assert not any(c.startswith("add ") and c.split()[1] in ("dop_bias", "angle_offset", "extinction") for c in both)
+    assert slot_of("remove shadowing", Model.from_string("paper")) == "shadowing"
+    assert slot_of("replace body by lambertian", Model.from_string("paper")) == "body"
+    assert slot_of("add dop_bias", Model.from_string("paper")) is None
+
+
 @pytest.fixture(scope="module")
 def swap_path(tmp_path_factory):
     """Data from specular+smith+lambertian (both of the paper's wrong parts replaced), fitted from paper with

@@ -65,9 +65,10 @@ def _vector(values: dict, posterior) -> np.ndarray:
 
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
-             priors: dict | None = None, base=None) -> dict:
+             priors: dict | None = None, base=None, confirm=()) -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
-    ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted)."""
+    ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted); ``confirm``:
+    change labels refitted whatever their screening gain."""
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
@@ -101,6 +102,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits
     twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
     to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]
+    to_confirm += [c for c in screened if c not in to_confirm and c["change"] in confirm]
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:
@@ -130,7 +132,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["screening_gain"] = c["screening_gain"]
         entry["explanation"] = _explain(c, base)
         ranking.append(entry)
-    for c in screened[len(to_confirm):]:
+    for c in [c for c in screened if c not in to_confirm]:
         ranking.append({"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
                         "significant": False, "screening_gain": c["screening_gain"],
                         "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."})

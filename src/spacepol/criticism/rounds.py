@@ -11,7 +11,8 @@ import numpy as np
 
 from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels
 from ..physics.model import Model
-from .diagnose import _structured, diagnose
+from .changes import slot_alternatives, slot_of
+from .diagnose import _structured, diagnose, significant
 
 
 def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
@@ -43,16 +44,20 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
     ``conclusion`` over the whole path; ``_reports`` keeps each round's full report."""
     reports, current = [], model
-    path = []
+    path, slots = [], set()
     for r in range(rounds):
         if progress:
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
+        # the other members of every slot the path has changed are always refitted: if the path stops here,
+        # the report says which of them the data cannot tell from the member chosen
+        confirm = slot_alternatives(current, data, slots, candidates) if slots else []
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
-                          progress=progress, priors=priors, base=base)
+                          progress=progress, priors=priors, base=base, confirm=confirm)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))
         if report["verdict"] == "none":
+            path[-1]["equivalent"] = _equivalent(report, confirm)
             break
         lead = next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -60,6 +65,9 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
                         for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead["change"]]
         path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"],
                           report["ranking"][0].get("tied_with", []), alternatives))
+        slot = slot_of(lead["change"], current)
+        if slot:
+            slots.add(slot)
         current, base = lead["_change"].model, lead["inversion"]
         if progress:
             print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "
@@ -67,6 +75,16 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     first = {k: v for k, v in reports[0].items() if not k.startswith("_")}
     out = {**first, "rounds": path, "final_model": current.name, "conclusion_rounds": _conclusion(path, reports)}
     out["_reports"] = reports
+    return out
+
+
+def _equivalent(report: dict, labels) -> list[dict]:
+    """Slot alternatives whose refit is not significantly better or worse than the final model: the data
+    cannot tell which member fills that slot."""
+    out = []
+    for e in report["ranking"]:
+        if e["change"] in labels and e["delta_elpd"] is not None and not significant(abs(e["delta_elpd"]), e["delta_elpd_se"]):
+            out.append({k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se")})
     return out
 
 
@@ -87,4 +105,7 @@ def _conclusion(path: list[dict], reports: list[dict]) -> str:
                  "does not have (or one the rounds did not reach).")
     else:
         text += f" Explained: the residuals of the final model {final['model']} look like noise ({fit})."
+    if final.get("equivalent"):
+        text += (" The data cannot tell the final model from these slot alternatives (neither significantly better): "
+                 + ", ".join(f"{e['change']} ({e['delta_elpd']:+.1f} +- {e['delta_elpd_se']:.1f})" for e in final["equivalent"]) + ".")
     return text

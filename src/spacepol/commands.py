@@ -151,14 +151,15 @@ def parse_observables(text: str | None) -> list[str] | None:
     """``--observables dop,brdf`` -> ["dop", "brdf"]; empty, unknown or repeated names are errors."""
     if text is None:
         return None
-    from .infer.likelihood import OBSERVABLES
+    from .observables import ALIASES, OBSERVABLES
 
     names = [o.strip() for o in text.split(",")]
     for name in names:
         if not name:
             raise ParameterError(f"--observables '{text}': an empty name (use e.g. dop,brdf)")
-        if name not in OBSERVABLES:
-            raise ParameterError(f"--observables '{text}': unknown observable '{name}' (use {', '.join(OBSERVABLES)})")
+        if name not in OBSERVABLES and name not in ALIASES:
+            raise ParameterError(f"--observables '{text}': unknown observable '{name}' (use {', '.join(OBSERVABLES)}; "
+                                 f"q, u name the Stokes pair)")
         if names.count(name) > 1:
             raise ParameterError(f"--observables '{text}': '{name}' named twice (each observable counts once)")
     return names

@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
-from ..infer.inference_data import median_fit, standardise
+from ..infer.inference_data import median_fit
 from ..infer.inversion import invert
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
@@ -168,13 +168,13 @@ def signatures(base, inv, base_fit=None) -> dict:
     """Per observable: the base fit's standardised residuals, and what the candidate changes in the
     prediction in the same noise units (its signature), their correlation and the share of the
     base chi^2 the candidate removes. ``base_fit``: the base's ``median_fit``, if already computed."""
-    data = base.posterior.likelihood.data
+    lik = base.posterior.likelihood
     mu0, scale = base_fit or median_fit(base.posterior, base.result.flat_samples())
     mu1, _ = median_fit(inv.posterior, inv.result.flat_samples())
     out = {}
     for o in base.posterior.likelihood.observables:
-        observed = standardise(data, o, mu0[o], scale[o])
-        remaining = standardise(data, o, mu1[o], scale[o])
+        observed = lik.standardise(o, mu0[o], scale[o])
+        remaining = lik.standardise(o, mu1[o], scale[o])
         signature = observed - remaining
         corr = float(np.corrcoef(observed, signature)[0, 1]) if np.std(signature) > 0 and np.std(observed) > 0 else 0.0
         out[o] = {"observed": observed, "signature": signature, "correlation": corr,

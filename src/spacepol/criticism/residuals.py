@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from ..infer.inference_data import median_fit, standardise
+from ..infer.inference_data import median_fit
 
 VARIABLES = ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level")
 
@@ -93,7 +93,7 @@ def lag1(residuals, groups) -> float:
 def analyse(posterior, samples) -> ResidualReport:
     data = posterior.likelihood.data
     mu, scale = median_fit(posterior, samples)
-    res = {o: standardise(data, o, mu[o], scale[o]) for o in posterior.likelihood.observables}
+    res = {o: posterior.likelihood.standardise(o, mu[o], scale[o]) for o in posterior.likelihood.observables}
     geo = data.geometry
     phase = np.degrees(np.arccos(np.clip(np.sum(geo.k_i * geo.k_r, axis=-1), -1, 1)))
     dop_level = mu["dop"] if "dop" in mu else (data.dop if data.dop is not None else np.zeros(len(data)))

@@ -7,7 +7,7 @@ import warnings
 import arviz as az
 import numpy as np
 
-from .inference_data import median_fit, standardise
+from .inference_data import median_fit
 from .posterior import Posterior
 from .result import Result
 
@@ -44,7 +44,7 @@ def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> di
     """RMSE of DOP and reduced chi^2 at the posterior-median prediction."""
     lik = posterior.likelihood
     mu, scale = median_fit(posterior, result.flat_samples())
-    chi2 = sum(float(np.sum(standardise(lik.data, o, mu[o], scale[o]) ** 2)) for o in lik.observables)
+    chi2 = sum(float(np.sum(lik.standardise(o, mu[o], scale[o]) ** 2)) for o in lik.observables)
     rmse = float(np.sqrt(np.mean((lik.data.dop - mu["dop"]) ** 2))) if "dop" in lik.observables else None
     dof = max(lik.n_obs - posterior.ndim, 1)
     return {"rmse_dop": rmse, "chi2_red": chi2 / dof, "elpd_loo": loo_result["elpd_loo"],

@@ -31,48 +31,29 @@ def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
 
 
 def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
-    """The noise level per observable and draw: (S, N) arrays (file errors or inferred)."""
+    """The noise level per channel and draw: (S, N) arrays (file errors or inferred)."""
     lik = posterior.likelihood
     params = posterior.priors.to_params(flat_theta)
-    out = {}
-    for o in lik.observables:
-        err = getattr(lik.data, f"{o}_err")
-        if err is not None:
-            out[o] = np.broadcast_to(err, (len(flat_theta), len(err)))
-        else:
-            key = lik.noise_parameter(o)
-            out[o] = np.broadcast_to(np.asarray(params[key])[:, None], (len(flat_theta), len(lik.data)))
-    return out
+    shape = (len(flat_theta), len(lik.data))
+    return {ch: np.broadcast_to(lik.scale(ch, params), shape) for ch in lik.observables}
 
 
 def median_fit(posterior: Posterior, samples):
-    """Posterior-median prediction and noise level per observable: ({o: (N,)}, {o: (N,)})."""
+    """Posterior-median prediction and noise level per channel: ({ch: (N,)}, {ch: (N,)})."""
     means, scales = predictive_means(posterior, samples), noise_scales(posterior, samples)
     return ({o: np.median(m, axis=0) for o, m in means.items()}, {o: np.median(v, axis=0) for o, v in scales.items()})
 
 
-def standardise(data, observable: str, mu, scale):
-    """(data - prediction) / noise, in log space for BRDF with inferred relative noise."""
-    y = getattr(data, observable)
-    if observable == "brdf" and data.brdf_err is None:
-        return (np.log(np.maximum(y, 1e-300)) - np.log(np.maximum(mu, 1e-300))) / scale
-    return (y - mu) / scale
-
-
 def standardised_residuals(posterior: Posterior, samples) -> dict[str, np.ndarray]:
     mu, scale = median_fit(posterior, samples)
-    return {o: standardise(posterior.likelihood.data, o, mu[o], scale[o]) for o in posterior.likelihood.observables}
+    lik = posterior.likelihood
+    return {ch: lik.standardise(ch, mu[ch], scale[ch]) for ch in lik.observables}
 
 
 def replicate(posterior: Posterior, means, scales, rng: np.random.Generator):
     """Replicated data y_rep = prediction + noise drawn like the measurement's."""
-    reps = {}
-    for o, mu in means.items():
-        if o == "brdf" and posterior.likelihood.data.brdf_err is None:
-            reps[o] = mu * np.exp(scales[o] * rng.standard_normal(mu.shape))
-        else:
-            reps[o] = mu + scales[o] * rng.standard_normal(mu.shape)
-    return reps
+    lik = posterior.likelihood
+    return {ch: lik.replicate(ch, mu, scales[ch], rng) for ch, mu in means.items()}
 
 
 def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Generator) -> az.InferenceData:

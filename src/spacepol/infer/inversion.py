@@ -37,8 +37,9 @@ def fingerprint(posterior: Posterior, walkers: int, seed: int) -> str:
     h.update(repr(sorted(posterior.priors.describe().items())).encode())
     h.update(repr(lik.observables).encode())
     h.update(np.ascontiguousarray(np.column_stack([lik.data.theta_i, lik.data.theta_r, lik.data.dphi])).tobytes())
+    observed = lik.observed()
     for o in lik.observables:
-        h.update(np.ascontiguousarray(getattr(lik.data, o)).tobytes())
+        h.update(np.ascontiguousarray(observed[o]).tobytes())
     h.update(f"{walkers}:{seed}".encode())
     return h.hexdigest()[:16]
 

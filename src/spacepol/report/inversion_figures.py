@@ -52,8 +52,9 @@ def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=N
     fitted observable, one column per incidence angle (at most ``max_panels``, evenly chosen).
     In-plane sweeps are drawn as curves; out-of-plane points (other azimuths at the same theta_r)
     as separate bars, since joining them in theta_r order would draw a sawtooth."""
-    data = posterior.likelihood.data
-    observables = list(observables or posterior.likelihood.observables)
+    lik = posterior.likelihood
+    data, observed = lik.data, lik.observed()
+    observables = list(observables or lik.observables)
     flat = result.flat_samples()
     rng = rng or np.random.default_rng(0)
     if len(flat) > max_draws:
@@ -67,8 +68,8 @@ def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=N
     axes = fig.subplots(len(observables), cols, squeeze=False)
     for row, observable in enumerate(observables):
         lo, med, hi = np.percentile(means[observable], [5, 50, 95], axis=0)
-        y = getattr(data, observable)
-        err = getattr(data, f"{observable}_err", None)
+        y = observed[observable]
+        err = None if lik.inferred(observable) else lik.scale(observable)
         for ax, (ti, idx) in zip(axes[row], panels):
             x = signed_theta_r(data, idx)
             plane = _in_plane(data, idx)

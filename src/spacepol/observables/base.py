@@ -1,0 +1,63 @@
+"""What an observable is: a measured quantity the likelihood compares with the model.
+
+An observable has one or more *channels*, each a vector over the N measured geometries (DOP has one,
+the normalised Stokes parameters two, q and u, the normalised Mueller matrix fifteen, m12 ... m44).
+It says from the model's output what each channel predicts, how a residual is formed, how the noise is
+modelled (the file's errors per row, or one inferred noise level for its channel group), its log
+density, how replicate data are drawn and its ArviZ dimensions. The likelihood, the residual analysis,
+the figures and the InferenceData use channels generically; adding an observable is one new file
+registered in ``observables/__init__.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..physics.parameter import Parameter
+
+_LOG_2PI = math.log(2 * math.pi)
+
+
+class Observable:
+    name: str = ""
+    channels: tuple[str, ...] = ()
+    label: str = ""  # axis label
+    needs_mueller: bool = False  # predictions need the model's full Mueller matrix
+    noise: Parameter | None = None  # the nuisance noise level of the channel group when the file gives none
+
+    def present(self, data) -> bool:
+        raise NotImplementedError
+
+    def observed(self, data) -> dict[str, np.ndarray]:
+        """{channel: (N,) measured values}."""
+        raise NotImplementedError
+
+    def errors(self, data) -> dict[str, np.ndarray] | None:
+        """{channel: (N,) 1-sigma errors} from the file, or None when the noise is to be inferred."""
+        return None
+
+    def predict(self, prediction) -> dict[str, np.ndarray]:
+        """{channel: (..., N) model values} from a ``physics.model.Prediction``."""
+        raise NotImplementedError
+
+    def residual(self, channel: str, y, mu, inferred: bool):
+        """Measured minus predicted, in the space where the noise is Gaussian."""
+        return y - mu
+
+    def log_density(self, resid, scale):
+        """Gaussian log density of the residuals at noise ``scale`` (same shape, broadcast)."""
+        return -0.5 * (resid / scale) ** 2 - np.log(scale) - 0.5 * _LOG_2PI
+
+    def replicate(self, channel: str, mu, scale, inferred: bool, rng: np.random.Generator):
+        """Replicate data drawn like the measurement: prediction plus noise in the residual's space."""
+        return mu + scale * rng.standard_normal(np.shape(mu))
+
+    def noise_parameter(self, channel: str) -> Parameter:
+        """The nuisance parameter holding ``channel``'s noise level when the file gives no errors."""
+        return self.noise
+
+    def dims(self, channel: str) -> list[str]:
+        """ArviZ dimensions of one channel's array over the geometries."""
+        return ["geometry"]

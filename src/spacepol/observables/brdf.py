@@ -1,0 +1,41 @@
+"""BRDF (sr^-1): Gaussian in BRDF with the file's ``brdf_err``; without it, Gaussian in log BRDF with an
+inferred relative noise (BRDF errors are multiplicative: gain, spot size, solid angle)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..infer.priors import LogUniform
+from ..physics.parameter import Parameter
+from .base import Observable
+
+_FLOOR = 1e-300
+
+
+class BRDF(Observable):
+    name = "brdf"
+    channels = ("brdf",)
+    label = "BRDF (sr^-1)"
+    noise = Parameter("sigma_brdf_rel", "", LogUniform(1e-3, 2.0), 0.05,
+                      "relative BRDF noise, sd of log BRDF (inferred: the file has no brdf_err)", physical=(1e-12, np.inf))
+
+    def present(self, data):
+        return data.brdf is not None
+
+    def observed(self, data):
+        return {"brdf": data.brdf}
+
+    def errors(self, data):
+        return None if data.brdf_err is None else {"brdf": data.brdf_err}
+
+    def predict(self, prediction):
+        return {"brdf": prediction.brdf}
+
+    def residual(self, channel, y, mu, inferred):
+        if inferred:
+            return np.log(np.maximum(y, _FLOOR)) - np.log(np.maximum(mu, _FLOOR))
+        return y - mu
+
+    def replicate(self, channel, mu, scale, inferred, rng):
+        z = rng.standard_normal(np.shape(mu))
+        return mu * np.exp(scale * z) if inferred else mu + scale * z

@@ -1,0 +1,61 @@
+"""The 15 normalised Mueller elements m_ij = M_ij / M_11 (NIST's 1-based naming; M_11 itself is the
+BRDF observable), Stokes basis as in DESIGN.md's geometry convention.
+
+Noise: the file's ``m_err`` (one error for every element of a row) or ``m12_err ... m44_err``; without
+them one inferred level per element group, since a polarimeter measures the groups with different
+optics: the polarizance/diattenuation row and column (m12 m13 m14 m21 m31 m41, generator or analyser
+alone), the linear block (m22 m23 m32 m33) and the elements that need a retarder on either side
+(m24 m34 m42 m43 m44)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..infer.priors import LogUniform
+from ..physics.parameter import Parameter
+from .base import Observable
+
+ELEMENTS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]
+GROUPS = {"pol": ("m12", "m13", "m14", "m21", "m31", "m41"), "lin": ("m22", "m23", "m32", "m33"),
+          "circ": ("m24", "m34", "m42", "m43", "m44")}
+_WORDS = {"pol": "polarizance and diattenuation elements m12 m13 m14 m21 m31 m41",
+          "lin": "linear block m22 m23 m32 m33", "circ": "circular elements m24 m34 m42 m43 m44"}
+NOISE = {g: Parameter(f"sigma_m_{g}", "", LogUniform(1e-4, 0.5), 0.01, f"noise of the normalised Mueller {_WORDS[g]} (inferred)",
+                      physical=(1e-12, np.inf)) for g in GROUPS}
+GROUP_OF = {e: g for g, members in GROUPS.items() for e in members}
+
+
+def index(element: str) -> tuple[int, int]:
+    return int(element[1]) - 1, int(element[2]) - 1
+
+
+def normalised(mueller) -> dict[str, np.ndarray]:
+    """{m_ij: M_ij / M_11} from a (4, 4, ...) Mueller array (0 where M_11 = 0)."""
+    m11 = np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)
+    return {e: mueller[index(e)] / m11 for e in ELEMENTS}
+
+
+class Mueller(Observable):
+    name = "mueller"
+    channels = ELEMENTS
+    label = "m_ij = M_ij / M_11"
+    needs_mueller = True
+
+    def present(self, data):
+        return data.mueller is not None
+
+    def observed(self, data):
+        return normalised(data.mueller)
+
+    def errors(self, data):
+        err = getattr(data, "mueller_err", None)
+        return None if err is None else {e: err[index(e)] for e in ELEMENTS}
+
+    def predict(self, prediction):
+        return normalised(prediction.mueller)
+
+    def noise_parameter(self, channel):
+        return NOISE[GROUP_OF[channel]]
+
+    def dims(self, channel):
+        return ["geometry"]

@@ -98,3 +98,82 @@ def test_observables_declare_their_channels_and_noise():
     assert Likelihood(data, Model.from_string(MODEL), observables=["q", "u"]).observables == ["q", "u"]  # aliases
     with pytest.raises(Exception, match="named twice"):
         Likelihood(data, Model.from_string(MODEL), observables=["dop", "dop"])
+
+
+def _mueller_csv(path, data, header_extra=None, row_edit=None, errors="m_err"):
+    from spacepol.io.measurements import MUELLER_COLUMNS, write_table
+
+    cols = {"theta_i": data.theta_i, "theta_r": data.theta_r, "dphi": data.dphi, "brdf": data.mueller[0, 0]}
+    for m in MUELLER_COLUMNS:
+        cols[m] = data.mueller[int(m[1]) - 1, int(m[2]) - 1] / data.mueller[0, 0]
+    if errors == "m_err":
+        cols["m_err"] = np.full(len(data), 0.01)
+    elif errors == "each":
+        cols.update({f"{m}_err": np.full(len(data), 0.01 + 0.001 * k) for k, m in enumerate(MUELLER_COLUMNS)})
+    for edit in (header_extra or []):
+        edit(cols)
+    write_table(path, cols)
+    if row_edit:
+        lines = path.read_text().splitlines()
+        lines[1] = row_edit(lines[0].split(","), lines[1].split(","))
+        path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_mueller_columns_are_read_with_their_errors(tmp_path):
+    from spacepol.io import read_measurements
+
+    data, _ = _data(np.random.default_rng(4))
+    back = read_measurements(_mueller_csv(tmp_path / "m.csv", data))
+    np.testing.assert_allclose(back.mueller, data.mueller, rtol=1e-12)
+    assert np.all(back.mueller_err[0, 1] == 0.01) and np.isnan(back.mueller_err[0, 0]).all()
+    each = read_measurements(_mueller_csv(tmp_path / "e.csv", data, errors="each"))
+    assert each.mueller_err[3, 3][0] == pytest.approx(0.01 + 0.001 * 14)  # m44_err, the 15th column
+    lik = Likelihood(each, Model.from_string(MODEL), observables=["mueller"])
+    assert lik.nuisance == [] and lik.scale("m44")[0] == pytest.approx(0.024)
+    inferred = read_measurements(_mueller_csv(tmp_path / "n.csv", data, errors=None))
+    assert inferred.mueller_err is None
+    assert {p.name for p in Likelihood(inferred, Model.from_string(MODEL), observables=["mueller"]).nuisance} == \
+        {"sigma_m_pol", "sigma_m_lin", "sigma_m_circ"}
+
+
+def _set_cell(column, text):
+    def edit(header, row):
+        row[header.index(column)] = text
+        return ",".join(row)
+    return edit
+
+
+@pytest.mark.parametrize("case, words", [
+    ("outside", ["m34", "outside [-1, 1]", "line 2"]),
+    ("missing", ["all 15 elements", "missing m43"]),
+    ("err_alone", ["m_err", "without the Mueller elements"]),
+    ("partial_errors", ["per-element Mueller errors", "missing m13_err"]),
+    ("dop_above_one", ["m21, m31, m41", "DOP", "> 1"]),
+])
+def test_bad_mueller_input_is_one_clear_error(tmp_path, case, words):
+    from spacepol.errors import InputFileError
+    from spacepol.io import read_measurements
+
+    data, _ = _data(np.random.default_rng(4))
+    if case == "outside":
+        path = _mueller_csv(tmp_path / "b.csv", data, row_edit=_set_cell("m34", "1.2"))
+    elif case == "missing":
+        path = _mueller_csv(tmp_path / "b.csv", data, header_extra=[lambda c: c.pop("m43")])
+    elif case == "err_alone":
+        from spacepol.io.measurements import write_table
+
+        path = tmp_path / "b.csv"
+        write_table(path, {"theta_i": data.theta_i, "theta_r": data.theta_r, "dop": data.dop, "m_err": np.full(len(data), 0.01)})
+    elif case == "partial_errors":
+        path = _mueller_csv(tmp_path / "b.csv", data, errors=None, header_extra=[lambda c: c.update(m12_err=np.full(len(data), 0.01))])
+    else:
+        def edit(header, row):
+            for m in ("m21", "m31"):
+                row[header.index(m)] = "0.8"
+            return ",".join(row)
+        path = _mueller_csv(tmp_path / "b.csv", data, row_edit=edit)
+    with pytest.raises(InputFileError) as err:
+        read_measurements(path)
+    message = str(err.value)
+    assert "\n" not in message and all(w in message for w in words), message

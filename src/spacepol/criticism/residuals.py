@@ -87,6 +87,8 @@ def lag1(residuals, groups) -> float:
         return float("nan")
     a = np.concatenate([p[0] for p in pairs])
     b = np.concatenate([p[1] for p in pairs])
+    if np.ptp(a) == 0 or np.ptp(b) == 0:
+        return float("nan")
     return float(np.corrcoef(a, b)[0, 1])
 
 
@@ -104,7 +106,7 @@ def analyse(posterior, samples) -> ResidualReport:
     for o, r in res.items():
         trends[o] = {}
         for name, v in variables.items():
-            if np.ptp(v) == 0:
+            if np.ptp(v) == 0 or np.ptp(r) == 0:  # a constant has no trend (e.g. an element measured as exactly 0)
                 continue
             rho, p = stats.spearmanr(v, r)
             trends[o][name] = {"rho": float(rho), "p": float(p)}

@@ -21,7 +21,9 @@ from ..errors import InputFileError
 from ..physics.geometry import Geometry
 
 GEOMETRY_COLUMNS = ("theta_i", "theta_r", "dphi", "wavelength_um")
-OBSERVABLE_COLUMNS = ("dop", "dop_err", "brdf", "brdf_err", "s0", "s1", "s2", "s3", "aop", "aop_err")
+MUELLER_COLUMNS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]  # m12 ... m44 = M_ij / M_11
+OBSERVABLE_COLUMNS = (("dop", "dop_err", "brdf", "brdf_err", "s0", "s1", "s2", "s3", "aop", "aop_err")
+                      + MUELLER_COLUMNS + ("m_err",) + tuple(f"{m}_err" for m in MUELLER_COLUMNS))
 KNOWN_COLUMNS = GEOMETRY_COLUMNS + OBSERVABLE_COLUMNS
 
 
@@ -40,7 +42,8 @@ class Dataset:
     stokes: np.ndarray | None = None  # (4, N): s0..s3 for unpolarized incidence (s3 may be 0)
     aop: np.ndarray | None = None  # deg
     aop_err: np.ndarray | None = None
-    mueller: np.ndarray | None = None  # (4, 4, N) BRDF Mueller matrix (sr^-1), when measured
+    mueller: np.ndarray | None = None  # (4, 4, N) BRDF Mueller matrix (sr^-1; M_11 = 1 when no BRDF was measured)
+    mueller_err: np.ndarray | None = None  # (4, 4, N) 1-sigma errors of the normalised elements m_ij (M_11's unused)
     metadata: dict = field(default_factory=dict)
     source: str = ""
 
@@ -83,6 +86,7 @@ class Dataset:
             changes[name] = None if value is None else value[idx]
         changes["stokes"] = None if self.stokes is None else self.stokes[:, idx]
         changes["mueller"] = None if self.mueller is None else self.mueller[:, :, idx]
+        changes["mueller_err"] = None if self.mueller_err is None else self.mueller_err[:, :, idx]
         return replace(self, **changes)
 
     def in_plane(self, tolerance_deg: float = 1e-6) -> "Dataset":
@@ -169,9 +173,10 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     stokes_cols = [c for c in ("s0", "s1", "s2") if c in header]
     if stokes_cols and len(stokes_cols) < 3:
         raise InputFileError(path, "Stokes data need all of s0, s1, s2", line=header_line)
-    has_observable = "dop" in header or "brdf" in header or len(stokes_cols) == 3
+    _check_mueller_header(header, path, header_line)
+    has_observable = "dop" in header or "brdf" in header or len(stokes_cols) == 3 or "m12" in header
     if require_observable and not has_observable:
-        raise InputFileError(path, "no observable column: need dop, brdf, or s0,s1,s2", line=header_line)
+        raise InputFileError(path, "no observable column: need dop, brdf, s0,s1,s2 or m12 ... m44", line=header_line)
     for err, base in (("dop_err", "dop"), ("brdf_err", "brdf"), ("aop_err", "aop")):
         if err in header and base not in header:
             raise InputFileError(path, f"column '{err}' without '{base}'", line=header_line)
@@ -188,6 +193,8 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
             value = _number(cell.strip(), path, line, column)
             _check_value(value, column, path, line)
             columns[column].append(value)
+        if "m21" in header:
+            _check_mueller_row(header, row, path, line)
     if not columns["theta_i"]:
         raise InputFileError(path, "empty file: header but no data rows", line=header_line)
 
@@ -203,6 +210,7 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     if len(stokes_cols) == 3:
         s3 = arrays.get("s3", np.zeros(n))
         stokes = np.array([arrays["s0"], arrays["s1"], arrays["s2"], s3])
+    mueller, mueller_err = _mueller(arrays, n)
     return Dataset(
         theta_i=arrays["theta_i"],
         theta_r=arrays["theta_r"],
@@ -215,9 +223,52 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
         stokes=stokes,
         aop=arrays.get("aop"),
         aop_err=arrays.get("aop_err"),
+        mueller=mueller,
+        mueller_err=mueller_err,
         metadata=meta,
         source=str(path),
     )
+
+
+def _check_mueller_header(header, path, line):
+    """All 15 normalised elements or none; errors as m_err, or per element for all 15."""
+    given = [m for m in MUELLER_COLUMNS if m in header]
+    if given and len(given) < 15:
+        missing = [m for m in MUELLER_COLUMNS if m not in header]
+        raise InputFileError(path, f"Mueller data need all 15 elements m12 ... m44; missing {', '.join(missing)}", line=line)
+    errors = [f"{m}_err" for m in MUELLER_COLUMNS if f"{m}_err" in header]
+    if (errors or "m_err" in header) and not given:
+        raise InputFileError(path, f"column '{(errors or ['m_err'])[0]}' without the Mueller elements m12 ... m44", line=line)
+    if errors and len(errors) < 15 and "m_err" not in header:
+        missing = [f"{m}_err" for m in MUELLER_COLUMNS if f"{m}_err" not in header]
+        raise InputFileError(path, f"per-element Mueller errors need all 15 columns (or one m_err for the rest); "
+                                   f"missing {', '.join(missing)}", line=line)
+
+
+def _check_mueller_row(header, row, path, line):
+    values = {c: float(v) for c, v in zip(header, row) if c in ("m21", "m31", "m41")}
+    dop = float(np.sqrt(values["m21"] ** 2 + values["m31"] ** 2 + values["m41"] ** 2))
+    if dop > 1:
+        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line,
+                             column="m21, m31, m41")
+
+
+def _mueller(arrays, n):
+    """(4, 4, N) Mueller matrix (M_11 = BRDF, or 1 without one) and its errors, or (None, None)."""
+    if "m12" not in arrays:
+        return None, None
+    m11 = arrays.get("brdf", np.ones(n))
+    mueller = np.empty((4, 4, n))
+    errors = np.full((4, 4, n), np.nan)
+    for name in ("m11",) + MUELLER_COLUMNS:
+        i, j = int(name[1]) - 1, int(name[2]) - 1
+        mueller[i, j] = m11 * (1.0 if name == "m11" else arrays[name])
+        if name != "m11":
+            err = arrays.get(f"{name}_err", arrays.get("m_err"))
+            if err is not None:
+                errors[i, j] = err
+    has_errors = "m_err" in arrays or "m12_err" in arrays
+    return mueller, (errors if has_errors else None)
 
 
 def _check_value(value, column, path, line):
@@ -231,6 +282,8 @@ def _check_value(value, column, path, line):
         raise InputFileError(path, f"wavelength {value:g} um must be positive", line=line, column=column)
     if column in ("brdf", "s0") and value < 0:
         raise InputFileError(path, f"negative intensity {value:g}", line=line, column=column)
+    if column in MUELLER_COLUMNS and abs(value) > 1:
+        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
 
 
 def write_table(path, columns: dict, metadata: dict | None = None) -> None:

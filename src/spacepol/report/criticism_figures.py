@@ -102,7 +102,7 @@ def ladder_figure(rungs, fig=None) -> Figure:
 def residual_trends_figure(structure, fig=None) -> Figure:
     """Standardised residuals against theta_i, theta_r, dphi, phase angle and the DOP level (one row per
     observable), each panel with its Spearman rank correlation; a red title marks p < 0.01."""
-    variables = [v for v in ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level") if v in structure.trends[structure.observables[0]]]
+    variables = [v for v in ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level") if np.ptp(structure.variables[v]) > 0]
     fig = fig or Figure(figsize=(2.6 * len(variables) + 0.5, 2.4 * len(structure.observables)), layout="constrained")
     axes = fig.subplots(len(structure.observables), len(variables), squeeze=False, sharey="row")
     for i, o in enumerate(structure.observables):
@@ -113,8 +113,9 @@ def residual_trends_figure(structure, fig=None) -> Figure:
             ax.axhline(0, color="k", lw=0.6)
             for level in (-2, 2):
                 ax.axhline(level, color="k", lw=0.4, ls=":")
-            t = structure.trends[o][var]
-            ax.set_title(f"rho {t['rho']:+.2f}, p {t['p']:.1g}", fontsize=7, color="C3" if t["p"] < 0.01 else "k")
+            t = structure.trends[o].get(var)  # none for a constant residual
+            if t is not None:
+                ax.set_title(f"rho {t['rho']:+.2f}, p {t['p']:.1g}", fontsize=7, color="C3" if t["p"] < 0.01 else "k")
             ax.set_xlabel(var.replace("_deg", " (deg)").replace("_", " "), fontsize=8)
             if j == 0:
                 ax.set_ylabel(f"{o} residual / noise", fontsize=8)

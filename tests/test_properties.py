@@ -10,7 +10,7 @@ from spacepol.physics.effects import registry
 # Two models that between them hold every built-in effect once.
 MODELS = [
     "specular+shadowing+body+polarized_diffuse+depolarization+oxide_layer+angle_offset+extinction+dop_bias",
-    "specular+smith+ggx+anisotropy+body+polarized_diffuse+lambertian",
+    "specular+smith+ggx+anisotropy+body+polarized_diffuse+lambertian+subsurface",
     # these two take the compiled Stokes kernel (isotropic facets, bulk Fresnel, fixed geometry)
     "specular+shadowing+body+polarized_diffuse+depolarization+extinction+dop_bias",
     "specular+smith+ggx+body",

@@ -43,6 +43,7 @@ HIDDEN_VALUES = {  # per built-in effect: a small and a large value, inside the 
     "dop_bias": [{"bias": 0.01}, {"bias": 0.05}],
     "oxide_layer": [{"thickness_um": 0.05, "n_film": 1.46}, {"thickness_um": 0.25, "n_film": 1.7}],
     "lambertian": [{"rho_l": 0.05}, {"rho_l": 0.3}],
+    "subsurface": [{"rho_s": 0.2}, {"rho_s": 0.7}],
 }
 NOISE = [(0.002, 0.01), (0.01, 0.05)]  # (DOP absolute, BRDF relative): a good lab polarimeter, a field one
 WAVELENGTH_UM = 0.633

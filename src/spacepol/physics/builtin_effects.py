@@ -215,22 +215,55 @@ class PolarizedDiffuse(Effect):
     removable = True
     intensity = "rho_pd"
     neutral = {"rho_pd": 0.0}
+    twins = {"subsurface": "no measurement on a transparent surface (the same shape T(theta_r) D T(theta_i)); "
+                           "on an absorbing one the Fresnel transmission differs slightly"}
 
     def lobe(self, ctx):
         geo = ctx.geometry
         n, k = ctx["n"], ctx["k"]
-
-        def transmission(cos_t):
-            sin2 = 1.0 - cos_t**2
-            r_s, r_p = fresnel.power(n, k, cos_t, sin2, sin2 / cos_t)
-            t_s, t_p = 1.0 - r_s, 1.0 - r_p
-            zero = np.zeros_like(t_s)
-            return [0.5 * (t_s + t_p), 0.5 * (t_s - t_p), zero, zero]
-
-        t_in = transmission(geo.cos_ti)
-        t_out = transmission(geo.cos_tr)
         scale = ctx["rho_pd"] / np.pi
-        return ctx.first_column_times_row([scale * c for c in t_out], t_in)
+        return ctx.first_column_times_row([scale * c for c in _transmission(n, k, geo.cos_tr)], _transmission(n, k, geo.cos_ti))
+
+
+def _transmission(n, k, cos_t):
+    """First row (= first column) of the Mueller matrix of Fresnel power transmission T = 1 - R into the
+    surface at angle theta from the normal (s and p transmittances; reciprocal, so the same out)."""
+    sin2 = 1.0 - cos_t**2
+    r_s, r_p = fresnel.power(n, k, cos_t, sin2, sin2 / cos_t)
+    t_s, t_p = 1.0 - r_s, 1.0 - r_p
+    zero = np.zeros_like(t_s)
+    return [0.5 * (t_s + t_p), 0.5 * (t_s - t_p), zero, zero]
+
+
+class Subsurface(Effect):
+    name = "subsurface"
+    parameters = (
+        Parameter("rho_s", "", Uniform(0.0, 1.0), 0.3, "albedo of the diffusely scattering material under the surface",
+                  physical=(0.0, 1.0)),
+    )
+    requires = ("specular",)
+    description = (
+        "Light scattered by a diffuse (Lambertian, albedo rho_s) material under a smooth transparent interface "
+        "(NIST SCATMECH's Diffuse_Subsurface_BRDF_Model; Germer, Proc. SPIE 5158, 2003): Fresnel transmission "
+        "in and out, the radiance divided by n^2 on leaving, and the light the interface reflects back in "
+        "(the internal hemispherical reflectance rho_i) recycled, f = rho_s / (pi n^2 (1 - rho_i rho_s)) "
+        "T(theta_r) D T(theta_i). The interface is taken as transparent (k = 0) for this light. Reciprocal."
+    )
+    slot = "body"
+    removable = True
+    intensity = "rho_s"
+    neutral = {"rho_s": 0.0}
+    twins = {"polarized_diffuse": "no measurement (for a transparent surface both have the shape T(theta_r) D T(theta_i); "
+                                  "rho_pd = rho_s / (n^2 (1 - rho_i rho_s)) converts one albedo into the other)"}
+
+    def lobe(self, ctx):
+        geo = ctx.geometry
+        n, rho = ctx["n"], ctx["rho_s"]
+        zero = np.zeros_like(n)
+        recycled = 1.0 / (1.0 - fresnel.hemispherical_internal_reflectance(n) * rho)
+        scale = rho * recycled / (np.pi * n**2)
+        return ctx.first_column_times_row([scale * c for c in _transmission(n, zero, geo.cos_tr)],
+                                          _transmission(n, zero, geo.cos_ti))
 
 
 class Depolarization(Effect):
@@ -406,6 +439,6 @@ class Lambertian(Effect):
 
 BUILTIN_EFFECTS = (
     Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
-    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian,
+    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian, Subsurface,
 )
 PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

@@ -94,3 +94,28 @@ def mueller_from_amplitudes(r_s, r_p):
             [zero, zero, -d, c],
         ]
     )
+
+
+# The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on
+# SCATMECH's grid (0 to 90 deg in 0.2 deg steps, Diffuse_Subsurface_BRDF_Model), so the two agree to
+# rounding. The trapezoid rule on it errs by ~1e-5 of the value (the kink at the critical angle).
+_INTERNAL_ANGLES = np.linspace(0.0, 0.5 * np.pi, 451)
+_INTERNAL_WEIGHTS = np.sin(2.0 * _INTERNAL_ANGLES)
+
+
+def internal_reflectance(n, cos_theta):
+    """Unpolarized reflectance (R_s + R_p)/2 of light inside a transparent medium of index n meeting its
+    surface (to vacuum) at internal angle theta; 1 beyond the critical angle (total internal reflection)."""
+    sin2 = 1.0 - cos_theta**2
+    cos_t = np.sqrt(np.asarray(1.0 - n**2 * sin2, dtype=complex))  # imaginary beyond the critical angle
+    r_s = (n * cos_theta - cos_t) / (n * cos_theta + cos_t)
+    r_p = (cos_theta - n * cos_t) / (cos_theta + n * cos_t)
+    return 0.5 * (np.abs(r_s) ** 2 + np.abs(r_p) ** 2)
+
+
+def hemispherical_internal_reflectance(n):
+    """The share of diffuse light inside a transparent medium of index n that its surface reflects back
+    in: the cos(theta) sin(theta) d(theta) weighted average of ``internal_reflectance``. Shape of ``n``."""
+    n = np.asarray(n, float)[..., None]
+    r = internal_reflectance(n, np.cos(_INTERNAL_ANGLES))
+    return np.sum(r * _INTERNAL_WEIGHTS, axis=-1) / np.sum(_INTERNAL_WEIGHTS)

@@ -20,6 +20,15 @@ def _int_at_least(low: int):
     return parse
 
 
+def _wavelengths(text: str):
+    """``0.633`` -> 0.633; ``0.532,0.633`` -> [0.532, 0.633]; ``all`` -> "all"."""
+    if text.strip().lower() == "all":
+        return "all"
+    one = _finite(0.0, strict=True)
+    values = [one(t.strip()) for t in text.split(",")]
+    return values[0] if len(values) == 1 else values
+
+
 def _finite(low: float | None = None, strict: bool = False):
     def parse(text: str) -> float:
         try:
@@ -75,7 +84,10 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("data", help="measurement file (spacepol CSV or NIST Mueller BRDF)")
         p.add_argument("--model", default="paper")
         p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
-        p.add_argument("--wavelength-um", type=_finite(0.0, strict=True), help="select one wavelength of a multi-wavelength file")
+        p.add_argument("--wavelength-um", type=_wavelengths, metavar="UM|LIST|all",
+                       help="one wavelength of a multi-wavelength file, a comma list, or all (inverted jointly: "
+                            "n, k per wavelength as n@LAMBDA, the rest shared)")
+        p.add_argument("--dispersion", metavar="n=cauchy", help="a dispersion law for n over several wavelengths")
         p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
         p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
         p.add_argument("--seed", type=SEED, default=0)

@@ -136,12 +136,19 @@ def demo(args) -> int:
 
 def load_dataset(args) -> Dataset:
     data = read_measurements(args.data)
+    chosen = args.wavelength_um
     if data.wavelength_um is not None and len(np.unique(data.wavelength_um)) > 1:
-        if args.wavelength_um is None:
+        if chosen is None:
             have = ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))
-            raise SpacepolError(f"{args.data}: holds several wavelengths ({have} um); choose one with --wavelength-um")
-    if args.wavelength_um is not None:
-        data = data.at_wavelength(args.wavelength_um)
+            raise SpacepolError(f"{args.data}: holds several wavelengths ({have} um); choose one with --wavelength-um, "
+                                f"a comma list, or all")
+    if isinstance(chosen, list):
+        data = data.at_wavelengths(chosen)
+    elif chosen == "all":
+        if data.wavelength_um is None:
+            raise SpacepolError(f"{args.data}: --wavelength-um all, but the file gives no wavelength")
+    elif chosen is not None:
+        data = data.at_wavelength(chosen)
     if args.in_plane:
         data = data.in_plane()
     return data
@@ -165,11 +172,35 @@ def parse_observables(text: str | None) -> list[str] | None:
     return names
 
 
+def model_for(args, data):
+    """The model named by --model; over several wavelengths a SpectralModel (n, k per wavelength, or
+    the --dispersion law)."""
+    model = build_model(args.model)
+    wavelengths = np.unique(data.wavelength_um) if data.wavelength_um is not None else []
+    dispersion = parse_dispersion(getattr(args, "dispersion", None))
+    if len(wavelengths) > 1:
+        from .physics.spectral import SpectralModel
+
+        return SpectralModel(model, wavelengths, dispersion)
+    if dispersion:
+        raise ParameterError(f"--dispersion {args.dispersion}: needs several wavelengths (--wavelength-um all or a list)")
+    return model
+
+
+def parse_dispersion(text: str | None) -> dict:
+    if not text:
+        return {}
+    name, sep, law = text.partition("=")
+    if not sep or not law:
+        raise ParameterError(f"--dispersion '{text}': write NAME=LAW, e.g. n=cauchy")
+    return {name.strip(): law.strip()}
+
+
 def build_posterior(args, data, robust=False):
     from .infer.posterior import Posterior
     from .infer.prior_set import read_prior_file
 
-    model = build_model(args.model)
+    model = model_for(args, data)
     overrides = read_prior_file(args.prior) if args.prior else None
     observables = parse_observables(args.observables)
     return Posterior.build(data, model, overrides, observables=observables, robust=robust,

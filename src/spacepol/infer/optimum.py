@@ -28,7 +28,8 @@ def _branches(posterior: Posterior):
     priors = posterior.priors
     for effect in posterior.likelihood.model.effects:
         for branch in effect.branches:
-            pinned = {n: v for n, v in branch.items() if n in priors.names}
+            # over several wavelengths a pinned parameter (k = 0) pins each copy (k@0.633, ...)
+            pinned = {n: v for name, v in branch.items() for n in priors.names if n == name or n.startswith(f"{name}@")}
             if not pinned or any(not priors.priors[n].bounds[0] <= v <= priors.priors[n].bounds[1] for n, v in pinned.items()):
                 continue
             overrides = {name: prior for name, prior in priors.priors.items() if name not in pinned}

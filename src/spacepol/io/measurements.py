@@ -94,6 +94,22 @@ class Dataset:
         off = np.abs(np.sin(np.radians(self.dphi)))
         return self.select(off < np.sin(np.radians(tolerance_deg)) + 1e-12)
 
+    def at_wavelengths(self, wavelengths_um, tolerance_um: float = 1e-4) -> "Dataset":
+        """The rows at any of ``wavelengths_um`` (each must be present)."""
+        keep = np.zeros(len(self), bool)
+        for w in wavelengths_um:
+            keep |= self.at_wavelength_mask(w, tolerance_um)
+        return self.select(keep)
+
+    def at_wavelength_mask(self, wavelength_um: float, tolerance_um: float = 1e-4):
+        if self.wavelength_um is None:
+            raise InputFileError(self.source, "has no wavelength to select on")
+        keep = np.abs(self.wavelength_um - wavelength_um) < tolerance_um
+        if not keep.any():
+            have = ", ".join(f"{w:g}" for w in np.unique(self.wavelength_um))
+            raise InputFileError(self.source, f"no rows at wavelength {wavelength_um:g} um (have {have})")
+        return keep
+
     def at_wavelength(self, wavelength_um: float, tolerance_um: float = 1e-4) -> "Dataset":
         if self.wavelength_um is None:
             raise InputFileError(self.source, "has no wavelength to select on")

@@ -1,0 +1,142 @@
+"""One model over several wavelengths: geometric parameters shared, optical constants per wavelength.
+
+The parameters an effect marks ``spectral`` (the refractive index n, k of the surface, a film's index)
+get one copy per wavelength, named ``NAME@LAMBDA`` with LAMBDA as written in the data (DESIGN.md,
+"Measurement files"); every other parameter (roughness, albedos, instrument effects) is shared. A
+dispersion law replaces the copies of one parameter by the law's coefficients:
+``cauchy`` for n, n(lambda) = A + B / lambda^2 (lambda in um; Cauchy 1836, the transparent-region law
+of glasses and polymers). The model is evaluated once per wavelength on that wavelength's rows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..infer.priors import Uniform
+from .geometry import Geometry
+from .model import Model, Prediction
+from .parameter import Parameter
+
+SPECTRAL = ("n", "k", "n_film")  # optical constants: they change with wavelength
+DISPERSION_LAWS = ("cauchy",)
+
+
+def wavelength_label(value: float) -> str:
+    """A wavelength as written in data files (0.633, 1.064): the shortest exact decimal."""
+    return f"{value:g}"
+
+
+def cauchy_parameters() -> list[Parameter]:
+    return [Parameter("n_cauchy_a", "", Uniform(1.0, 3.0), 1.5, "Cauchy dispersion: n at infinite wavelength",
+                      physical=(0.0, np.inf)),
+            Parameter("n_cauchy_b", "um^2", Uniform(-0.05, 0.1), 0.005, "Cauchy dispersion: n = A + B / lambda^2")]
+
+
+class SpectralModel:
+    """``model`` over ``wavelengths_um``; ``dispersion`` maps a spectral parameter to a law (``{"n": "cauchy"}``)."""
+
+    def __init__(self, model: Model, wavelengths_um, dispersion: dict | None = None):
+        self.model = model
+        self.wavelengths = sorted(float(w) for w in wavelengths_um)
+        self.labels = [wavelength_label(w) for w in self.wavelengths]
+        self.dispersion = dict(dispersion or {})
+        for name, law in self.dispersion.items():
+            if law not in DISPERSION_LAWS:
+                raise ParameterError(f"dispersion law '{law}' for {name}: use one of {', '.join(DISPERSION_LAWS)}")
+            if name != "n":
+                raise ParameterError(f"dispersion law '{law}' applies to n only, not {name}")
+        own = {p.name for p in model.parameters}
+        self.spectral = [n for n in SPECTRAL if n in own]
+        if "n" in self.dispersion and "n" not in own:
+            raise ParameterError(f"--dispersion n=cauchy: model {model.name} has no n")
+        self._geometries: dict = {}
+
+    @property
+    def name(self) -> str:
+        return self.model.name
+
+    @property
+    def effects(self):
+        return self.model.effects
+
+    @property
+    def parameters(self) -> list[Parameter]:
+        out = []
+        for p in self.model.parameters:
+            if p.name not in self.spectral:
+                out.append(p)
+            elif self.dispersion.get(p.name) == "cauchy":
+                out.extend(cauchy_parameters())
+            else:
+                out.extend(Parameter(f"{p.name}@{label}", p.unit, p.prior, p.default, f"{p.description} at {label} um",
+                                     p.fixed, p.physical) for label in self.labels)
+        return out
+
+    def defaults(self) -> dict:
+        return {p.name: p.default for p in self.parameters}
+
+    def values_at(self, params: dict, j: int) -> dict:
+        """The inner model's parameters at wavelength j."""
+        label, lam = self.labels[j], self.wavelengths[j]
+        out = {k: v for k, v in params.items() if "@" not in k and not k.startswith("n_cauchy_")}
+        for name in self.spectral:
+            if self.dispersion.get(name) == "cauchy":
+                out[name] = np.asarray(params["n_cauchy_a"]) + np.asarray(params["n_cauchy_b"]) / lam**2
+            elif f"{name}@{label}" in params:
+                out[name] = params[f"{name}@{label}"]
+        return out
+
+    def derived(self, params: dict) -> dict:
+        """Per-wavelength values a dispersion law implies (``n@0.633`` from A and B), for reports."""
+        out = {}
+        for name, law in self.dispersion.items():
+            for j, label in enumerate(self.labels):
+                out[f"{name}@{label}"] = self.values_at(params, j)[name]
+        return out
+
+    def _groups(self, geometry: Geometry):
+        key = id(geometry)
+        if key not in self._geometries:
+            if geometry.wavelength_um is None:
+                raise ParameterError("several wavelengths need a wavelength per measurement")
+            groups = []
+            for lam in self.wavelengths:
+                idx = np.flatnonzero(np.abs(geometry.wavelength_um - lam) < 1e-6)
+                if idx.size:
+                    sub = Geometry(geometry.theta_i[..., idx], geometry.theta_r[..., idx], geometry.dphi[..., idx],
+                                   geometry.wavelength_um[idx])
+                    groups.append((idx, sub))
+                else:
+                    groups.append((idx, None))
+            covered = sum(idx.size for idx, _ in groups)
+            if covered != geometry.size:
+                raise ParameterError(f"{geometry.size - covered} measurements lie at none of the wavelengths "
+                                     f"{', '.join(self.labels)} um")
+            self._geometries[key] = (geometry, groups)  # the geometry is kept so its id stays unique
+        return self._geometries[key][1]
+
+    def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
+        parts = [(idx, self.model.evaluate(self.values_at(params, j), sub, mueller=mueller, check=check))
+                 for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
+        return _assemble(parts, geometry.size, mueller)
+
+    def check_plugins(self, params: dict, geometry: Geometry) -> Prediction:
+        parts = [(idx, self.model.check_plugins(self.values_at(params, j), sub))
+                 for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
+        return _assemble(parts, geometry.size, False)
+
+
+def _assemble(parts, size: int, mueller: bool) -> Prediction:
+    """One Prediction over all rows from the per-wavelength ones (rows in the data's order)."""
+    first = parts[0][1]
+
+    def gather(get):
+        lead = get(first).shape[:-1]
+        out = np.empty(lead + (size,))
+        for idx, pred in parts:
+            out[..., idx] = np.broadcast_to(get(pred), lead + (idx.size,))
+        return out
+
+    return Prediction(stokes=gather(lambda p: p.stokes), dop=gather(lambda p: p.dop),
+                      mueller=gather(lambda p: p.mueller) if mueller else None)

@@ -12,7 +12,9 @@ body term) for E in none, dop_bias, angle_offset, extinction, polarized_diffuse,
 (``spacepol.criticism.swap_suite``). Right = the path holds the shadowing swap and E (or a tied
 twin), the nulls gain no addition, and the final reduced chi^2 < 1.5.
 
-Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts).
+Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts). A partial run
+(``--effects``, ``--no-swaps``, ``--only-swaps``) updates the cases it ran in an existing
+hidden_effects.json and keeps the others, so one part can be re-measured alone.
 """
 
 import argparse
@@ -40,15 +42,23 @@ def main():
     rows = [] if args.only_swaps else run_suite(suite(args.effects), jobs=args.jobs)
     seconds_hidden = time.perf_counter() - start
     swap_rows = [] if args.no_swaps else run_swaps(args.jobs)
-    summary = {**(summarise(rows) if rows else {}), **(summarise_swaps(swap_rows) if swap_rows else {})}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    previous = json.loads((out / "hidden_effects.json").read_text()) if (out / "hidden_effects.json").exists() else {}
+    rows, swap_rows = _merge(previous.get("cases", []), rows), _merge(previous.get("swap_cases", []), swap_rows)
+    summary = {**(summarise(rows) if rows else {}), **(summarise_swaps(swap_rows) if swap_rows else {})}
     write_json(out / "hidden_effects.json", {"summary": summary, "cases": rows, "swap_cases": swap_rows,
                                              "seconds": {"hidden": seconds_hidden, "total": time.perf_counter() - start}})
     save_figure(validation_figure(rows, swap_rows), out / "hidden_effects.png")
     (out / "hidden_effects.md").write_text(_table(rows) + _swap_table(swap_rows) + "\n" + json.dumps(summary, indent=1) + "\n")
     print(json.dumps(summary, indent=1))
     print(f"{time.perf_counter() - start:.0f} s; wrote {out}/hidden_effects.json, .md, .png")
+
+
+def _merge(old: list[dict], new: list[dict]) -> list[dict]:
+    """Rows of this run replace the stored rows of the same case; the other stored rows are kept."""
+    fresh = {r["label"]: r for r in new}
+    return [fresh.pop(r["label"], r) for r in old] + list(fresh.values())
 
 
 def run_swaps(jobs: int) -> list[dict]:

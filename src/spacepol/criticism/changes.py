@@ -110,14 +110,6 @@ def slot_alternatives(model: Model, data, slots, names=None) -> list[str]:
     return out
 
 
-def slot_of(change_label: str, before: Model) -> str | None:
-    """The slot a removal or a replacement acted on (None for additions)."""
-    change = parse(before, change_label)
-    if change.kind == "add":
-        return None
-    return registry.get(change.replaced if change.kind == "replace" else change.effect).slot
-
-
 def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
     """Where the optimiser starts the changed model: at the base model's optimum, the new effect's own
     parameters at its ``neutral`` values (where it changes nothing), its default, the prior's ends and

@@ -98,7 +98,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
 
     clock["screening"] = time.perf_counter()
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
-    to_confirm = screened[:top] + [c for c in screened[top:] if screened and _close(c["screening_gain"], screened[0]["screening_gain"])]
+    to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c["screening_gain"], screened[0]["screening_gain"])]
     # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits
     twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
     to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]

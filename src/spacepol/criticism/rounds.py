@@ -11,7 +11,7 @@ import numpy as np
 
 from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels
 from ..physics.model import Model
-from .changes import slot_alternatives, slot_of
+from .changes import changes, slot_alternatives
 from .diagnose import _structured, diagnose, significant
 
 
@@ -44,20 +44,18 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
     ``conclusion`` over the whole path; ``_reports`` keeps each round's full report."""
     reports, current = [], model
-    path, slots = [], set()
+    path = []
     for r in range(rounds):
         if progress:
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
-        # the other members of every slot the path has changed are always refitted: if the path stops here,
-        # the report says which of them the data cannot tell from the member chosen
-        confirm = slot_alternatives(current, data, slots, candidates) if slots else []
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
-                          progress=progress, priors=priors, base=base, confirm=confirm)
+                          progress=progress, priors=priors, base=base)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))
         if report["verdict"] == "none":
-            path[-1]["equivalent"] = _equivalent(report, confirm)
+            path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
+                                                       priors, report["_base"])
             break
         lead = next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -65,9 +63,6 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
                         for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead["change"]]
         path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"],
                           report["ranking"][0].get("tied_with", []), alternatives))
-        slot = slot_of(lead["change"], current)
-        if slot:
-            slots.add(slot)
         current, base = lead["_change"].model, lead["inversion"]
         if progress:
             print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "
@@ -76,6 +71,25 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     out = {**first, "rounds": path, "final_model": current.name, "conclusion_rounds": _conclusion(path, reports)}
     out["_reports"] = reports
     return out
+
+
+def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base) -> list[dict]:
+    """Where the path stopped: refit every other member of each of the final model's slots (and the slot
+    emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
+    the conclusion can say which parts of the final model the data pin down."""
+    slots = {e.slot for e in model.effects if e.slot}
+    labels = slot_alternatives(model, data, slots, candidates)
+    if not labels:
+        return []
+    if progress:
+        print(f"  the path stopped at {model.name}: weighing each slot's other members ({len(labels)} refits)",
+              file=sys.stderr, flush=True)
+    names = sorted({w for label in labels for w in label.split() if w not in ("add", "remove", "replace", "by")})
+    # the user's prior overrides that concern these models (the others belong to effects not weighed here)
+    known = set(base.posterior.names) | {p.name for c in changes(model, data, names) for p in c.model.parameters}
+    report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=False,
+                      priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels)
+    return _equivalent(report, labels)
 
 
 def _equivalent(report: dict, labels) -> list[dict]:

@@ -33,11 +33,23 @@ def loo(idata) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = az.loo(idata, pointwise=True, var_name="y")
-    k = np.asarray(res.pareto_k)
+    k = np.asarray(res.pareto_k, float).copy()
+    pointwise = np.asarray(res.loo_i, float).copy()
+    failed = ~np.isfinite(pointwise)
+    if failed.any():
+        # PSIS breaks down (NaN) where one observation's log-likelihood spans hundreds of units across the
+        # draws: take its in-sample log predictive density instead (an overestimate of its ELPD) and flag
+        # it as a bad Pareto k, so the report says LOO is unreliable there
+        from scipy.special import logsumexp
+
+        ll = idata.log_likelihood["y"].values.reshape(-1, pointwise.size)
+        pointwise[failed] = logsumexp(ll[:, failed], axis=0) - np.log(ll.shape[0])
+        k[failed] = np.inf
     labels = list(idata.log_likelihood["obs_id"].values)
     bad = [labels[i] for i in np.flatnonzero(k > 0.7)]
-    return {"elpd_loo": float(res.elpd_loo), "elpd_loo_se": float(res.se), "p_loo": float(res.p_loo),
-            "pareto_k": k, "pareto_k_bad": bad, "pointwise": np.asarray(res.loo_i)}
+    n = pointwise.size
+    return {"elpd_loo": float(pointwise.sum()), "elpd_loo_se": float(np.sqrt(n * np.var(pointwise))),
+            "p_loo": float(res.p_loo), "pareto_k": k, "pareto_k_bad": bad, "pointwise": pointwise}
 
 
 def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:

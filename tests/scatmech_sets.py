@@ -1,0 +1,67 @@
+"""Full-Mueller measurement sets rendered by an independent implementation (NIST SCATMECH via pySCATMECH):
+Beckmann facets (Facet_BRDF_Model, Gaussian slopes s = sqrt(2) sigma, no shadowing: spacepol's `specular`)
+plus one hidden effect or none:
+
+* "depolarization": a share d of the facet light depolarized, (1 - d) M + d M11 diag(1, 0, 0, 0);
+* "extinction": an analyser of efficiency e in front of the detector, diag(1, e, e, e) M;
+* "subsurface": SCATMECH's Diffuse_Subsurface_BRDF_Model added (albedo rho under the smooth interface).
+
+Each set holds the BRDF (M11, relative noise) and the 15 normalised elements m_ij (absolute noise)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spacepol.io.measurements import Dataset
+from spacepol.physics.geometry import Geometry
+
+MATERIAL = {"n": 1.5, "k": 0.0, "sigma": 0.2}  # a smooth-ish dielectric (paint, plastic)
+HIDDEN = {"none": {}, "depolarization": {"d": 0.3}, "extinction": {"e": 0.8}, "subsurface": {"rho": 0.6}}
+
+
+def geometry() -> Geometry:
+    """In-plane sweeps at theta_i 20, 45, 65 deg and out-of-plane rings at theta_i 45 deg (dphi 150, 120)."""
+    ti = np.repeat([20.0, 45.0, 65.0], 13)
+    tr = np.tile(np.linspace(0.0, 78.0, 13), 3)
+    ti2 = np.full(16, 45.0)
+    tr2 = np.tile(np.linspace(10.0, 70.0, 8), 2)
+    dp2 = np.repeat([150.0, 120.0], 8)
+    return Geometry(np.concatenate([ti, ti2]), np.concatenate([tr, tr2]), np.concatenate([np.full(39, 180.0), dp2]))
+
+
+def mueller_set(kind: str, noise_m: float = 0.005, noise_brdf: float = 0.02, seed: int = 0) -> Dataset:
+    from pySCATMECH.brdf import BRDF_Model
+
+    m = MATERIAL
+    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": f"({m['n']},{m['k']})", "type": 0,
+                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
+    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": f"({m['n']},0)", "type": 0,
+                                                        "reflectance": "Table_Reflectance",
+                                                        "reflectance.table": HIDDEN["subsurface"]["rho"]})
+    g = geometry()
+    mueller = np.empty((4, 4, g.size))
+    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
+        args = np.radians([ti, tr, 180.0 - dphi])  # SCATMECH's phi_s = 0 is the specular direction
+        M = np.array(facets.MuellerBRDF(*args))
+        if kind == "depolarization":
+            d = HIDDEN[kind]["d"]
+            M = (1 - d) * M + d * M[0, 0] * np.diag([1.0, 0, 0, 0])
+        elif kind == "extinction":
+            M = np.diag([1.0] + [HIDDEN[kind]["e"]] * 3) @ M
+        elif kind == "subsurface":
+            M = M + np.array(under.MuellerBRDF(*args))
+        mueller[:, :, j] = M
+    rng = np.random.default_rng(seed)
+    normalised = mueller / mueller[0, 0]
+    noisy = normalised + noise_m * rng.standard_normal(normalised.shape)
+    noisy[0, 0] = 1.0
+    brdf = mueller[0, 0] * (1 + noise_brdf * rng.standard_normal(g.size))
+    data = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=np.full(g.size, 0.633))
+    data.mueller = np.clip(noisy, -1, 1) * brdf
+    data.mueller_err = np.full((4, 4, g.size), noise_m)
+    data.brdf, data.brdf_err = brdf, noise_brdf * mueller[0, 0]
+    # the same measurement reduced to DOP (from the first column) and BRDF
+    data.dop = np.clip(np.sqrt(np.sum(noisy[1:, 0] ** 2, axis=0)), 0, 1)
+    data.dop_err = np.full(g.size, noise_m)
+    data.source = f"SCATMECH render ({kind})"
+    return data

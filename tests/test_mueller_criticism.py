@@ -10,12 +10,13 @@ from scatmech_sets import mueller_set
 from spacepol.criticism.diagnose import diagnose
 from spacepol.physics import Model
 
+TWINS = ["depolarization", "extinction"]
 CANDIDATES = ["depolarization", "extinction", "subsurface", "polarized_diffuse", "lambertian", "dop_bias"]
 
 
-def _diagnose(kind, observables):
+def _diagnose(kind, observables, candidates=TWINS):
     return diagnose(mueller_set(kind, seed=2), Model.from_string("specular"), np.random.default_rng(0), seed=0,
-                    observables=observables, candidates=CANDIDATES, top=2, progress=False, max_steps=6000)
+                    observables=observables, candidates=candidates, top=2, progress=False, max_steps=6000)
 
 
 @pytest.mark.parametrize("kind", ["depolarization", "extinction"])
@@ -37,7 +38,19 @@ def test_dop_and_brdf_of_the_same_data_leave_them_tied(kind):
 
 
 def test_a_hidden_subsurface_term_is_named_and_the_null_set_gets_none():
-    report = _diagnose("subsurface", ["mueller", "brdf"])
+    report = _diagnose("subsurface", ["mueller", "brdf"], CANDIDATES)
     assert report["verdict"] in ("subsurface", "polarized_diffuse"), report["verdict"]
-    null = _diagnose("none", ["mueller", "brdf"])
+    null = _diagnose("none", ["mueller", "brdf"], CANDIDATES)
     assert null["verdict"] == "none", [(r["change"], r["delta_elpd"]) for r in null["ranking"][:3]]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["none", "depolarization", "extinction", "subsurface"])
+def test_the_whole_library_on_full_mueller_sets(kind):
+    """As the held-out check runs: the whole library, base `specular`, full Mueller + BRDF."""
+    report = _diagnose(kind, ["mueller", "brdf"], None)
+    expected = {"none": {"none"}, "depolarization": {"depolarization"}, "extinction": {"extinction"},
+                "subsurface": {"subsurface", "polarized_diffuse"}}[kind]
+    assert report["verdict"] in expected, [(r["change"], r["delta_elpd"]) for r in report["ranking"][:4]]
+    if kind in ("depolarization", "extinction"):
+        assert not set(report["ranking"][0].get("tied_with", [])) & {"depolarization", "extinction"}

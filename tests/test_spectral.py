@@ -61,4 +61,9 @@ def test_a_cauchy_law_is_recovered_from_four_wavelengths(cauchy_fit):
         sd = 0.5 * (p[name]["q84"] - p[name]["q16"])
         assert abs(p[name]["median"] - TRUTH[name]) < 3 * sd, (name, p[name])
     assert all(p[f"k@{lam:g}"]["q95"] >= 0.0 for lam in LAMBDAS)
+    derived = cauchy_fit.summary["derived"]  # n at each wavelength, as DESIGN names them
+    assert list(derived) == ["n@0.351", "n@0.532", "n@0.633", "n@1.064"]
+    for lam in LAMBDAS:
+        q = derived[f"n@{lam:g}"]
+        assert q["q05"] <= TRUTH["n_cauchy_a"] + TRUTH["n_cauchy_b"] / lam**2 <= q["q95"], (lam, q)
     assert not p["n_cauchy_b"]["q05"] <= 0.02 <= p["n_cauchy_b"]["q95"]

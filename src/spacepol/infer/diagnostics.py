@@ -65,14 +65,22 @@ def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> di
 
 def quantiles(result: Result) -> dict:
     flat = result.flat_samples()
-    out = {}
-    for j, name in enumerate(result.names):
-        q = np.percentile(flat[:, j], [5, 16, 50, 84, 95])
-        out[name] = {"median": float(q[2]), "q05": float(q[0]), "q16": float(q[1]), "q84": float(q[3]), "q95": float(q[4])}
-    return out
+    return {name: quantile_dict(flat[:, j]) for j, name in enumerate(result.names)}
 
 
-NUISANCE_NOISE = ("sigma_dop", "sigma_brdf_rel", "sigma_qu")
+def quantile_dict(values) -> dict:
+    q = np.percentile(values, [5, 16, 50, 84, 95])
+    return {"median": float(q[2]), "q05": float(q[0]), "q16": float(q[1]), "q84": float(q[3]), "q95": float(q[4])}
+
+
+def _noise_names() -> tuple[str, ...]:
+    from ..observables import OBSERVABLES
+
+    names = [o.noise_parameter(ch).name for o in OBSERVABLES.values() for ch in o.channels]
+    return tuple(dict.fromkeys(names))
+
+
+NUISANCE_NOISE = _noise_names()
 
 
 def inferred_noise_levels(summary: dict) -> dict[str, float]:

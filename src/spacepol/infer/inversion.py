@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from .chain_file import chain_iterations, compact
-from .diagnostics import convergence, fit_statistics, loo, quantiles
+from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
 from .inference_data import to_inference_data
@@ -108,6 +108,10 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "sampler": {k: v for k, v in result.info.items() if k != "tau"} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
+    derived = getattr(posterior.likelihood.model, "derived", None)
+    if derived is not None:  # values a dispersion law implies per wavelength (n@0.633 from A and B)
+        values = derived(posterior.priors.to_params(result.flat_samples()))
+        summary["derived"] = {name: quantile_dict(np.asarray(v, float).ravel()) for name, v in values.items()}
     ident = identifiability(posterior, result)
     summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
     from ..criticism.residuals import analyse

@@ -81,6 +81,9 @@ def _html(inv, data_path, figures, truths, notes) -> str:
         rows.append([name + (" (at a bound)" if flagged else ""), f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
                      f"{diag['per_parameter'][name]['rhat']:.4f}", f"{diag['per_parameter'][name]['ess_bulk']:.0f}",
                      "" if truth is None else f"{truth:.4g}", s["priors"].get(name, "")])
+    for name, q in s.get("derived", {}).items():  # implied by a dispersion law, not sampled themselves
+        rows.append([f"{name} (from the dispersion law)", f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]",
+                     f"[{q['q16']:.4g}, {q['q84']:.4g}]", "", "", "" if truths.get(name) is None else f"{truths[name]:.4g}", ""])
     converged = diag["rhat_max"] <= 1.01 and diag["ess_min"] >= 400 and not s["sampler"].get("capped")
     verdict = ("Converged: R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
                "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting the intervals.")

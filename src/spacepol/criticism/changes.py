@@ -75,8 +75,11 @@ def _index(model: Model, name: str) -> int:
 
 def changes(model: Model, data, names=None) -> list[Change]:
     """Every change of ``model`` that composes and that the data allow; ``names`` restricts the
-    effects considered (added, brought in or removed)."""
+    effects considered (added, brought in or removed). Effects without a slot (pure additions) already in
+    the model may be removed or replaced by another pure addition: an addition taken early, while another
+    part of the model was still wrong, can then give way to the one the data prefer once the rest is right."""
     present = [e.name for e in model.effects]
+    additions = [e.name for e in model.effects if not e.slot]
     out: list[Change] = []
     for name in names or registry.names():
         if name in present:
@@ -84,14 +87,15 @@ def changes(model: Model, data, names=None) -> list[Change]:
         cls = registry.get(name)
         if cls().applicable(data) is not None:
             continue
-        for change in [("add", None)] + [("replace", e.name) for e in model.effects if cls.slot and e.slot == cls.slot]:
+        replaced = [e.name for e in model.effects if cls.slot and e.slot == cls.slot] if cls.slot else additions
+        for change in [("add", None)] + [("replace", old) for old in replaced]:
             try:
                 label = f"add {name}" if change[0] == "add" else f"replace {change[1]} by {name}"
                 out.append(Change(change[0], name, apply(model, label), replaced=change[1]))
             except SpacepolError:
                 continue  # does not compose (e.g. smith beside shadowing, ggx without specular)
     for e in model.effects:
-        if e.removable and (names is None or e.name in names):
+        if (e.removable or not e.slot) and (names is None or e.name in names):
             try:
                 out.append(Change("remove", e.name, apply(model, f"remove {e.name}")))
             except SpacepolError:

@@ -103,6 +103,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
     to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]
     to_confirm += [c for c in screened if c not in to_confirm and c["change"] in confirm]
+    # the two best simplifications (fewer free parameters) that screening does not rule out: if nothing is
+    # significant, diagnose --rounds takes one that predicts as well (Occam)
+    simpler = [c for c in screened if c not in to_confirm and c["posterior"].ndim < base_post.ndim
+               and c["screening_gain"] > -2 * MIN_DELTA_ELPD]
+    to_confirm += simpler[:2]
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:
@@ -150,7 +155,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                 sep = sep or "a measurement in which they predict differently"
                 ranking[0]["explanation"] += (f" It fits these data as well as '{other['change']}' (equal within noise): the "
                                               f"two are twins here; {sep} would separate them.")
+    for entry, c in zip(ranking, confirmed):
+        entry["free_parameters"] = c["posterior"].ndim
     return {"model": model.name, "fit": base.summary["fit"], "ranking": ranking, "verdict": verdict,
+            "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
             "seconds": {"base_fit": clock["base"] - clock["start"], "screening": clock["screening"] - clock["base"],

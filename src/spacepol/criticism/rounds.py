@@ -53,16 +53,20 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))
+        simplification = None
         if report["verdict"] == "none":
-            path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
-                                                       priors, report["_base"])
-            break
-        lead = next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
+            simplification = _simplification(report)
+            if simplification is None:
+                path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
+                                                           priors, report["_base"])
+                break
+        lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
         alternatives = [{k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se", "significant")}
                         for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead["change"]]
         path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"],
-                          report["ranking"][0].get("tied_with", []), alternatives))
+                          [] if simplification else report["ranking"][0].get("tied_with", []), alternatives))
+        path[-1]["simplification"] = simplification is not None
         current, base = lead["_change"].model, lead["inversion"]
         if progress:
             print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "
@@ -71,6 +75,15 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     out = {**first, "rounds": path, "final_model": current.name, "conclusion_rounds": _conclusion(path, reports)}
     out["_reports"] = reports
     return out
+
+
+def _simplification(report: dict):
+    """Where no change is significant: a refitted change with fewer free parameters that predicts as well
+    (not significantly worse, the rule of ``significant``): the fewest parameters first, then the best ELPD."""
+    base_ndim = report["_base"].posterior.ndim
+    simpler = [c for c in report["_confirmed"] if c["posterior"].ndim < base_ndim
+               and not significant(-c["delta_elpd"], c["delta_elpd_se"])]
+    return min(simpler, key=lambda c: (c["posterior"].ndim, -c["delta_elpd"])) if simpler else None
 
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base) -> list[dict]:
@@ -104,9 +117,9 @@ def _equivalent(report: dict, labels) -> list[dict]:
 
 def _conclusion(path: list[dict], reports: list[dict]) -> str:
     final = path[-1]
-    changes = [p["change"] for p in path[1:]]
+    changes = [p["change"] + (" (simpler, predicts as well)" if p.get("simplification") else "") for p in path[1:]]
     route = " -> ".join([path[0]["model"]] + changes) if changes else path[0]["model"]
-    stopped = ("no further change is significant" if reports[-1]["verdict"] == "none"
+    stopped = ("no further change is significant" if "equivalent" in final
                else f"the round limit was reached ({len(reports)})")
     if not changes:
         text = f"No change of {path[0]['model']} improves ELPD-LOO by more than 2 SE (and 4)."

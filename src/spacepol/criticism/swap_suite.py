@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 
 from ..io.measurements import Dataset
 from ..physics.model import Model
+from ..physics.registry import registry
 from .hidden_effects import HIDDEN_VALUES, NOISE, WAVELENGTH_UM, sampling
 from .rounds import diagnose_rounds
 
@@ -95,8 +96,9 @@ def score(case: SwapCase, result: dict) -> dict:
     if case.effect is None:  # no addition of an effect the surface does not have (smith refilling its slot is fine)
         effect_ok = not [a for a in additions if a.split()[1] not in case.spec.split("+")]
     else:
-        effect_ok = f"add {case.effect}" in path or any(a.split()[1] in tied for a in additions) or \
-            any(case.effect in c for c in path)
+        twins = set(registry.get(case.effect).twins)  # declared twins count, as tied ones do
+        effect_ok = f"add {case.effect}" in path or any(a.split()[1] in tied | twins for a in additions) or \
+            any(case.effect in c or any(t in c for t in twins) for c in path)
     return {"label": case.label, "effect": case.effect or "none", "material": case.material, "sampling": case.sampling,
             "noise_dop": case.noise[0], "path": path, "final_model": result["final_model"],
             "chi2_red_final": final["fit"]["chi2_red"],

@@ -105,12 +105,15 @@ def changes(model: Model, data, names=None) -> list[Change]:
 
 def slot_alternatives(model: Model, data, slots, names=None) -> list[str]:
     """The changes of ``model`` that put another member into each of ``slots``, fill it when it is empty
-    or empty it: what the data must be able to tell from the member the path chose."""
+    or empty it: what the data must be able to tell from the member the path chose. (A second member
+    beside a filled slot's is an addition, not an alternative.)"""
+    filled = {e.slot for e in model.effects if e.slot}
     out = []
     for change in changes(model, data, names):
         cls = registry.get(change.effect)
-        if cls.slot in slots:
-            out.append(change.label)
+        if cls.slot not in slots or (change.kind == "add" and cls.slot in filled):
+            continue
+        out.append(change.label)
     return out
 
 

@@ -134,6 +134,7 @@ def swap_figure(rows: list[dict], ax=None) -> Figure:
     ax.axhline(1.0, color="k", lw=0.6)
     ax.axhline(1.5, color="k", ls=":", lw=0.8)
     ax.set_yscale("log")
+    ax.set_xticks(range(max((len(r["chi2_red_per_round"]) for r in rows), default=1)))
     ax.set_xlabel("round (0 = the paper's model)")
     ax.set_ylabel("reduced chi^2 (known noise)")
     ax.legend(fontsize=7, title="hidden effect (dotted: wrong path)", title_fontsize=7)

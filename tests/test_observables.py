@@ -177,3 +177,29 @@ def test_bad_mueller_input_is_one_clear_error(tmp_path, case, words):
         read_measurements(path)
     message = str(err.value)
     assert "\n" not in message and all(w in message for w in words), message
+
+
+def test_mueller_residuals_are_drawn_as_the_matrix():
+    """The 4 x 4 residual figure: one panel per element (BRDF at 1,1), titled with its RMS; red where the
+    RMS exceeds 1.5 (a wrong index: the control)."""
+    from spacepol.infer.posterior import Posterior
+    from spacepol.report.inversion_figures import mueller_residual_figure
+
+    data, _ = _data(np.random.default_rng(4))
+    data.mueller_err = np.full((4, 4, len(data)), 0.01)
+    data.brdf_err = 0.05 * data.brdf
+    post = Posterior.build(data, Model.from_string(MODEL), observables=["mueller", "brdf"])
+
+    class Draws:  # a posterior that is one point
+        def __init__(self, values):
+            self.values = np.array([[values[n] for n in post.names]] * 4)
+
+        def flat_samples(self):
+            return self.values
+
+    good = mueller_residual_figure(post, Draws(TRUTH))
+    titles = [ax.get_title() for ax in good.axes if ax.get_title()]
+    assert len(titles) == 16 and titles[0].startswith("brdf") and titles[-1].startswith("m44")
+    assert all(ax.title.get_color() == "k" for ax in good.axes if ax.get_title())
+    bad = mueller_residual_figure(post, Draws({**TRUTH, "n": 1.9}))
+    assert any(ax.title.get_color() == "C3" for ax in bad.axes if ax.get_title())

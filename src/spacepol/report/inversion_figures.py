@@ -122,3 +122,40 @@ def residual_figure(posterior, result, fig=None) -> Figure:
     axes[0].set_title("Standardised residuals (data - posterior-median prediction) / noise; noise alone stays within +-2",
                       fontsize=9)
     return fig
+
+
+def mueller_residual_figure(posterior, result, fig=None) -> Figure:
+    """Standardised residuals of a full-Mueller fit laid out as the matrix: panel (i, j) holds m_ij's
+    residuals against signed theta_r (colour: theta_i), panel (1, 1) the BRDF's when it was fitted. A
+    misfit confined to a row (the analyser side) or a column (the generator side) points to an instrument
+    effect; one spread over the whole matrix to the sample's physics."""
+    from ..infer.inference_data import standardised_residuals
+
+    lik = posterior.likelihood
+    data, residuals = lik.data, standardised_residuals(posterior, result.flat_samples())
+    x = signed_theta_r(data)
+    fig = fig or Figure(figsize=(11.0, 9.0), layout="constrained")
+    axes = fig.subplots(4, 4, sharex=True)
+    dots = None
+    for i in range(4):
+        for j in range(4):
+            ax = axes[i, j]
+            name = "brdf" if i == j == 0 else f"m{i + 1}{j + 1}"
+            if name not in residuals:
+                ax.set_axis_off()
+                continue
+            z = residuals[name]
+            dots = ax.scatter(x, z, s=4, c=data.theta_i, cmap="viridis", alpha=0.7)
+            for level in (-2, 2):
+                ax.axhline(level, color="k", lw=0.4, ls=":")
+            ax.axhline(0, color="k", lw=0.6)
+            rms = float(np.sqrt(np.mean(z**2)))
+            ax.set_title(f"{name}: RMS {rms:.2f}", fontsize=8, color="C3" if rms > 1.5 else "k")
+            ax.tick_params(labelsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("theta_r (deg; < 0: source side)", fontsize=7)
+    if dots is not None:
+        fig.colorbar(dots, ax=axes.ravel().tolist(), label="theta_i (deg)", shrink=0.6)
+    fig.suptitle("Standardised residuals per Mueller element (noise alone: RMS ~ 1, within +-2; red title: RMS > 1.5)",
+                 fontsize=9)
+    return fig

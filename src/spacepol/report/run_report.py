@@ -13,7 +13,7 @@ from . import html as H
 from ..criticism.residuals import analyse
 from .criticism_figures import residual_trends_figure
 from ..infer.identifiability import bound_finding
-from .inversion_figures import corner_figure, fit_figure, residual_figure
+from .inversion_figures import corner_figure, fit_figure, mueller_residual_figure, residual_figure
 
 
 def truths_from_metadata(metadata: dict) -> dict:
@@ -62,6 +62,8 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
         "residuals.png": residual_figure(posterior, result),
         "residual_trends.png": residual_trends_figure(analyse(posterior, result.flat_samples())),
     }
+    if "m12" in posterior.likelihood.observables:
+        figures["residuals_mueller.png"] = mueller_residual_figure(posterior, result)
     for name, fig in figures.items():
         save_figure(fig, out / name)
     with atomic_path(out / "posterior.nc") as tmp:
@@ -108,6 +110,8 @@ def _html(inv, data_path, figures, truths, notes) -> str:
          + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction, "
                    "per observable (rows) and incidence angle (columns).")
          + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")
+         + (H.image(H.figure_to_data_uri(figures["residuals_mueller.png"]), "Residuals laid out as the Mueller matrix.")
+            if "residuals_mueller.png" in figures else "")
          + H.image(H.figure_to_data_uri(figures["residual_trends.png"]),
                    "Residuals against each angle and the DOP level, with Spearman's rho (red: p < 0.01).")),
         ("Posterior", H.image(H.figure_to_data_uri(figures["corner.png"]), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),

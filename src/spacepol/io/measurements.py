@@ -98,10 +98,11 @@ class Dataset:
         """The rows at any of ``wavelengths_um`` (each must be present)."""
         keep = np.zeros(len(self), bool)
         for w in wavelengths_um:
-            keep |= self.at_wavelength_mask(w, tolerance_um)
+            keep |= self._rows_at(w, tolerance_um)
         return self.select(keep)
 
-    def at_wavelength_mask(self, wavelength_um: float, tolerance_um: float = 1e-4):
+    def _rows_at(self, wavelength_um: float, tolerance_um: float):
+        """Boolean mask of the rows at ``wavelength_um``; absent -> one line naming the wavelengths there are."""
         if self.wavelength_um is None:
             raise InputFileError(self.source, "has no wavelength to select on")
         keep = np.abs(self.wavelength_um - wavelength_um) < tolerance_um
@@ -111,13 +112,7 @@ class Dataset:
         return keep
 
     def at_wavelength(self, wavelength_um: float, tolerance_um: float = 1e-4) -> "Dataset":
-        if self.wavelength_um is None:
-            raise InputFileError(self.source, "has no wavelength to select on")
-        keep = np.abs(self.wavelength_um - wavelength_um) < tolerance_um
-        if not keep.any():
-            have = ", ".join(f"{w:g}" for w in np.unique(self.wavelength_um))
-            raise InputFileError(self.source, f"no rows at wavelength {wavelength_um:g} um (have {have})")
-        out = self.select(keep)
+        out = self.select(self._rows_at(wavelength_um, tolerance_um))
         out.metadata = {**self.metadata, "wavelength_um": wavelength_um}
         return out
 
@@ -205,12 +200,13 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
             continue
         if len(row) != len(header):
             raise InputFileError(path, f"{len(row)} fields, header has {len(header)}", line=line)
+        values = {}
         for column, cell in zip(header, row):
-            value = _number(cell.strip(), path, line, column)
-            _check_value(value, column, path, line)
-            columns[column].append(value)
-        if "m21" in header:
-            _check_mueller_row(header, row, path, line)
+            values[column] = _number(cell.strip(), path, line, column)
+            _check_value(values[column], column, path, line)
+            columns[column].append(values[column])
+        if "m21" in values:
+            check_first_column(values["m21"], values["m31"], values["m41"], path, line, "m21, m31, m41")
     if not columns["theta_i"]:
         raise InputFileError(path, "empty file: header but no data rows", line=header_line)
 
@@ -261,12 +257,16 @@ def _check_mueller_header(header, path, line):
                                    f"missing {', '.join(missing)}", line=line)
 
 
-def _check_mueller_row(header, row, path, line):
-    values = {c: float(v) for c, v in zip(header, row) if c in ("m21", "m31", "m41")}
-    dop = float(np.sqrt(values["m21"] ** 2 + values["m31"] ** 2 + values["m41"] ** 2))
+def check_mueller_element(value, path, line, column):
+    if abs(value) > 1:
+        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
+
+
+def check_first_column(m21, m31, m41, path, line, column):
+    """The state unpolarized light leaves in (m21, m31, m41): its degree of polarization cannot exceed 1."""
+    dop = float(np.sqrt(m21**2 + m31**2 + m41**2))
     if dop > 1:
-        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line,
-                             column="m21, m31, m41")
+        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line, column=column)
 
 
 def _mueller(arrays, n):
@@ -298,8 +298,8 @@ def _check_value(value, column, path, line):
         raise InputFileError(path, f"wavelength {value:g} um must be positive", line=line, column=column)
     if column in ("brdf", "s0") and value < 0:
         raise InputFileError(path, f"negative intensity {value:g}", line=line, column=column)
-    if column in MUELLER_COLUMNS and abs(value) > 1:
-        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
+    if column in MUELLER_COLUMNS:
+        check_mueller_element(value, path, line, column)
 
 
 def write_table(path, columns: dict, metadata: dict | None = None) -> None:

@@ -30,7 +30,7 @@ def _wrap_deg(angle):
 
 
 def read_nist_rows(path, header, lines, header_line, meta):
-    from .measurements import Dataset, _number
+    from .measurements import Dataset, _number, check_first_column, check_mueller_element
 
     if len(header) != 21:
         raise InputFileError(path, f"NIST Mueller layout needs 21 columns, header has {len(header)}", line=header_line)
@@ -51,13 +51,8 @@ def read_nist_rows(path, header, lines, header_line, meta):
         if values[5] < 0:
             raise InputFileError(path, f"negative BRDF {values[5]:g}", line=line, column=header[5])
         for i in range(6, 21):
-            if abs(values[i]) > 1:
-                raise InputFileError(path, f"normalised Mueller element {values[i]:g} outside [-1, 1]", line=line, column=header[i])
-        # first column (m21, m31, m41): the state unpolarized light leaves in; its degree cannot exceed 1
-        dop_row = float(np.sqrt(values[9] ** 2 + values[13] ** 2 + values[17] ** 2))
-        if dop_row > 1:
-            raise InputFileError(path, f"m21, m31, m41 imply DOP {dop_row:.4g} > 1 for unpolarized light", line=line,
-                                 column=f"{header[9]}, {header[13]}, {header[17]}")
+            check_mueller_element(values[i], path, line, header[i])
+        check_first_column(values[9], values[13], values[17], path, line, f"{header[9]}, {header[13]}, {header[17]}")
         rows.append(values)
     if not rows:
         raise InputFileError(path, "empty file: header but no data rows", line=header_line)

@@ -219,10 +219,13 @@ class PolarizedDiffuse(Effect):
                            "on an absorbing one the Fresnel transmission differs slightly"}
 
     def lobe(self, ctx):
-        geo = ctx.geometry
-        n, k = ctx["n"], ctx["k"]
-        scale = ctx["rho_pd"] / np.pi
-        return ctx.first_column_times_row([scale * c for c in _transmission(n, k, geo.cos_tr)], _transmission(n, k, geo.cos_ti))
+        return _through_interface(ctx, ctx["rho_pd"] / np.pi, ctx["n"], ctx["k"])
+
+
+def _through_interface(ctx, scale, n, k):
+    """scale x T(theta_r) D T(theta_i): depolarized light under the surface, Fresnel-transmitted in and out."""
+    geo = ctx.geometry
+    return ctx.first_column_times_row([scale * c for c in _transmission(n, k, geo.cos_tr)], _transmission(n, k, geo.cos_ti))
 
 
 def _transmission(n, k, cos_t):
@@ -257,13 +260,9 @@ class Subsurface(Effect):
                                   "rho_pd = rho_s / (n^2 (1 - rho_i rho_s)) converts one albedo into the other)"}
 
     def lobe(self, ctx):
-        geo = ctx.geometry
         n, rho = ctx["n"], ctx["rho_s"]
-        zero = np.zeros_like(n)
         recycled = 1.0 / (1.0 - fresnel.hemispherical_internal_reflectance(n) * rho)
-        scale = rho * recycled / (np.pi * n**2)
-        return ctx.first_column_times_row([scale * c for c in _transmission(n, zero, geo.cos_tr)],
-                                          _transmission(n, zero, geo.cos_ti))
+        return _through_interface(ctx, rho * recycled / (np.pi * n**2), n, np.zeros_like(n))
 
 
 class Depolarization(Effect):

@@ -105,11 +105,9 @@ _INTERNAL_WEIGHTS = np.sin(2.0 * _INTERNAL_ANGLES)
 
 def internal_reflectance(n, cos_theta):
     """Unpolarized reflectance (R_s + R_p)/2 of light inside a transparent medium of index n meeting its
-    surface (to vacuum) at internal angle theta; 1 beyond the critical angle (total internal reflection)."""
-    sin2 = 1.0 - cos_theta**2
-    cos_t = np.sqrt(np.asarray(1.0 - n**2 * sin2, dtype=complex))  # imaginary beyond the critical angle
-    r_s = (n * cos_theta - cos_t) / (n * cos_theta + cos_t)
-    r_p = (cos_theta - n * cos_t) / (cos_theta + n * cos_t)
+    surface (to vacuum) at internal angle theta: ``amplitudes`` with the relative index 1/n; 1 beyond the
+    critical angle (total internal reflection)."""
+    r_s, r_p = amplitudes(1.0 / np.asarray(n, float), cos_theta, 1.0 - cos_theta**2)
     return 0.5 * (np.abs(r_s) ** 2 + np.abs(r_p) ** 2)
 
 

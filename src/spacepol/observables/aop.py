@@ -10,7 +10,7 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import Observable
+from .base import ColumnObservable
 
 
 def wrap_deg(angle):
@@ -18,21 +18,12 @@ def wrap_deg(angle):
     return (np.asarray(angle) + 90.0) % 180.0 - 90.0
 
 
-class AoP(Observable):
+class AoP(ColumnObservable):
     name = "aop"
     channels = ("aop",)
     label = "AoP (deg)"
     noise = Parameter("sigma_aop_deg", "deg", LogUniform(1e-2, 30.0), 1.0,
                       "AoP noise level (inferred: the file has no aop_err)", physical=(1e-12, np.inf))
-
-    def present(self, data):
-        return data.aop is not None
-
-    def observed(self, data):
-        return {"aop": data.aop}
-
-    def errors(self, data):
-        return None if data.aop_err is None else {"aop": data.aop_err}
 
     def predict(self, prediction):
         return {"aop": prediction.aop_deg}

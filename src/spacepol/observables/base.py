@@ -61,3 +61,17 @@ class Observable:
     def dims(self, channel: str) -> list[str]:
         """ArviZ dimensions of one channel's array over the geometries."""
         return ["geometry"]
+
+
+class ColumnObservable(Observable):
+    """One channel read from the Dataset attribute of the same name, with its errors in ``NAME_err``."""
+
+    def present(self, data):
+        return getattr(data, self.name) is not None
+
+    def observed(self, data):
+        return {self.name: getattr(data, self.name)}
+
+    def errors(self, data):
+        err = getattr(data, f"{self.name}_err")
+        return None if err is None else {self.name: err}

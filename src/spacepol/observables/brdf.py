@@ -7,26 +7,17 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import Observable
+from .base import ColumnObservable
 
 _FLOOR = 1e-300
 
 
-class BRDF(Observable):
+class BRDF(ColumnObservable):
     name = "brdf"
     channels = ("brdf",)
     label = "BRDF (sr^-1)"
     noise = Parameter("sigma_brdf_rel", "", LogUniform(1e-3, 2.0), 0.05,
                       "relative BRDF noise, sd of log BRDF (inferred: the file has no brdf_err)", physical=(1e-12, np.inf))
-
-    def present(self, data):
-        return data.brdf is not None
-
-    def observed(self, data):
-        return {"brdf": data.brdf}
-
-    def errors(self, data):
-        return None if data.brdf_err is None else {"brdf": data.brdf_err}
 
     def predict(self, prediction):
         return {"brdf": prediction.brdf}

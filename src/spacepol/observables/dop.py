@@ -6,24 +6,15 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import Observable
+from .base import ColumnObservable
 
 
-class DOP(Observable):
+class DOP(ColumnObservable):
     name = "dop"
     channels = ("dop",)
     label = "DOP"
     noise = Parameter("sigma_dop", "", LogUniform(1e-4, 0.5), 0.01,
                       "DOP noise level (inferred: the file has no dop_err)", physical=(1e-12, np.inf))
-
-    def present(self, data):
-        return data.dop is not None
-
-    def observed(self, data):
-        return {"dop": data.dop}
-
-    def errors(self, data):
-        return None if data.dop_err is None else {"dop": data.dop_err}
 
     def predict(self, prediction):
         return {"dop": prediction.dop}

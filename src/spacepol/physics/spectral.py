@@ -48,6 +48,7 @@ class SpectralModel:
                 raise ParameterError(f"dispersion law '{law}' applies to n only, not {name}")
         own = {p.name for p in model.parameters}
         self.spectral = [n for n in SPECTRAL if n in own]
+        self.shared = [n for n in own if n not in self.spectral]
         if "n" in self.dispersion and "n" not in own:
             raise ParameterError(f"--dispersion n=cauchy: model {model.name} has no n")
         self._geometries: dict = {}
@@ -79,7 +80,7 @@ class SpectralModel:
     def values_at(self, params: dict, j: int) -> dict:
         """The inner model's parameters at wavelength j."""
         label, lam = self.labels[j], self.wavelengths[j]
-        out = {k: v for k, v in params.items() if "@" not in k and not k.startswith("n_cauchy_")}
+        out = {k: params[k] for k in self.shared if k in params}
         for name in self.spectral:
             if self.dispersion.get(name) == "cauchy":
                 out[name] = np.asarray(params["n_cauchy_a"]) + np.asarray(params["n_cauchy_b"]) / lam**2

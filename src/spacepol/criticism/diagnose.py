@@ -65,10 +65,11 @@ def _vector(values: dict, posterior) -> np.ndarray:
 
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
-             priors: dict | None = None, base=None, confirm=()) -> dict:
+             priors: dict | None = None, base=None, confirm=(), simplifications: int = 0) -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
     ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted); ``confirm``:
-    change labels refitted whatever their screening gain."""
+    change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
+    parameters to refit besides (for diagnose --rounds, which may take one when nothing is significant)."""
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
@@ -103,11 +104,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
     to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]
     to_confirm += [c for c in screened if c not in to_confirm and c["change"] in confirm]
-    # the two best simplifications (fewer free parameters) that screening does not rule out: if nothing is
+    # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
     # significant, diagnose --rounds takes one that predicts as well (Occam)
     simpler = [c for c in screened if c not in to_confirm and c["posterior"].ndim < base_post.ndim
                and c["screening_gain"] > -2 * MIN_DELTA_ELPD]
-    to_confirm += simpler[:2]
+    to_confirm += simpler[:simplifications]
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:

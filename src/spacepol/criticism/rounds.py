@@ -49,7 +49,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
         if progress:
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
-                          progress=progress, priors=priors, base=base)
+                          progress=progress, priors=priors, base=base, simplifications=2)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))

@@ -58,3 +58,26 @@ def test_printed_eq15_would_fail(N):
     dop_bad = (r_s - r_p_paper) / (r_s + r_p_paper)
     worst = {1.24: 0.17, 1.405: 0.31}[N.real]
     assert np.max(np.abs(dop_ok - dop_bad)) > worst - 0.01
+
+
+def test_rotated_mueller_is_the_product_of_rotations_and_fresnel_matrix():
+    """The closed form equals L(eta_out) @ M_F @ L(eta_in) computed as plain 4 x 4 products."""
+    rng = np.random.default_rng(3)
+    N = rng.uniform(0.2, 4, 50) + 1j * rng.uniform(0, 8, 50)
+    cos_b = rng.uniform(0.05, 1, 50)
+    r_s, r_p = fresnel.amplitudes(N, cos_b, 1 - cos_b**2)
+    eta_i, eta_r = rng.uniform(-np.pi, np.pi, (2, 50))
+    scale = rng.uniform(0.1, 3, 50)
+
+    def rotator(eta):
+        c, s = np.cos(2 * eta), np.sin(2 * eta)
+        return np.array([[1, 0, 0, 0], [0, c, s, 0], [0, -s, c, 0], [0, 0, 0, 1]], dtype=float)
+
+    got = fresnel.rotated_mueller(r_s, r_p, np.cos(2 * eta_i), np.sin(2 * eta_i), np.cos(2 * eta_r), np.sin(2 * eta_r), scale)
+    m_f = fresnel.mueller_from_amplitudes(r_s, r_p)
+    for j in range(50):
+        want = rotator(eta_r[j]) @ m_f[:, :, j] @ rotator(eta_i[j]) * scale[j]
+        np.testing.assert_allclose(got[:, :, j], want, rtol=0, atol=1e-14)
+    # negative control: the rotations swapped give a different matrix
+    swapped = fresnel.rotated_mueller(r_s, r_p, np.cos(2 * eta_r), np.sin(2 * eta_r), np.cos(2 * eta_i), np.sin(2 * eta_i), scale)
+    assert np.max(np.abs(swapped - got)) > 1e-2

@@ -11,24 +11,6 @@ from .parameter import Parameter
 from .shadowing import PAPER_CONSTANTS, paper_shadowing
 
 
-def _rotator(two_eta_cos, two_eta_sin):
-    """Stokes basis rotation L(eta): S1' = c S1 + s S2, S2' = -s S1 + c S2."""
-    one, zero = np.ones_like(two_eta_cos), np.zeros_like(two_eta_cos)
-    return np.array(
-        [
-            [one, zero, zero, zero],
-            [zero, two_eta_cos, two_eta_sin, zero],
-            [zero, -two_eta_sin, two_eta_cos, zero],
-            [zero, zero, zero, one],
-        ]
-    )
-
-
-def _matmul(a, b):
-    """(4, 4, ...) x (4, 4, ...) Mueller product, broadcasting over the trailing axes."""
-    return np.einsum("ij...,jk...->ik...", a, b)
-
-
 class Specular(Effect):
     name = "specular"
     parameters = (
@@ -76,10 +58,8 @@ class Specular(Effect):
                 r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             else:
                 r_s, r_p = fresnel.amplitudes(ctx["n"] + 1j * ctx["k"], geo.cos_beta, geo.sin2_beta)
-            m_f = fresnel.mueller_from_amplitudes(*np.broadcast_arrays(r_s, r_p))
-            rot_in = _rotator(np.cos(2 * geo.eta_i), np.sin(2 * geo.eta_i))
-            rot_out = _rotator(geo.cos_2eta_r, geo.sin_2eta_r)
-            return _matmul(rot_out, _matmul(m_f, rot_in)) * scalar
+            cos_2in, sin_2in = geo.cached("two_eta_i", lambda: (np.cos(2 * geo.eta_i), np.sin(2 * geo.eta_i)))
+            return fresnel.rotated_mueller(r_s, r_p, cos_2in, sin_2in, geo.cos_2eta_r, geo.sin_2eta_r, scalar)
         if ctx.fresnel_amplitudes is not None:
             r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             big_rs, big_rp = np.abs(r_s) ** 2, np.abs(r_p) ** 2

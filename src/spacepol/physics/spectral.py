@@ -104,13 +104,15 @@ class SpectralModel:
             groups = []
             for lam in self.wavelengths:
                 idx = np.flatnonzero(np.abs(geometry.wavelength_um - lam) < 1e-6)
-                if idx.size:
+                if idx.size and idx[-1] - idx[0] + 1 == idx.size:
+                    idx = slice(int(idx[0]), int(idx[-1]) + 1)  # a block of rows: copied, not gathered
+                if np.size(geometry.wavelength_um[idx]):
                     sub = Geometry(geometry.theta_i[..., idx], geometry.theta_r[..., idx], geometry.dphi[..., idx],
                                    geometry.wavelength_um[idx])
                     groups.append((idx, sub))
                 else:
                     groups.append((idx, None))
-            covered = sum(idx.size for idx, _ in groups)
+            covered = sum(0 if sub is None else sub.size for _, sub in groups)
             if covered != geometry.size:
                 raise ParameterError(f"{geometry.size - covered} measurements lie at none of the wavelengths "
                                      f"{', '.join(self.labels)} um")
@@ -136,8 +138,10 @@ def _assemble(parts, size: int, mueller: bool) -> Prediction:
         lead = get(first).shape[:-1]
         out = np.empty(lead + (size,))
         for idx, pred in parts:
-            out[..., idx] = np.broadcast_to(get(pred), lead + (idx.size,))
+            out[..., idx] = get(pred)
         return out
 
-    return Prediction(stokes=gather(lambda p: p.stokes), dop=gather(lambda p: p.dop),
-                      mueller=gather(lambda p: p.mueller) if mueller else None)
+    if mueller:
+        total = gather(lambda p: p.mueller)
+        return Prediction(stokes=total[:, 0], dop=gather(lambda p: p.dop), mueller=total)
+    return Prediction(stokes=gather(lambda p: p.stokes), dop=gather(lambda p: p.dop))

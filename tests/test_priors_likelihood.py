@@ -115,4 +115,12 @@ def test_normalised_stokes_observables():
     side = (ptfe.dphi == 180.0) & (ptfe.theta_i >= 45) & (ptfe.theta_r >= 40)
     assert np.all(pred.stokes[1][side] > 0) and np.all(ptfe.q[side] > 0)
     assert np.allclose(pred.stokes[2], 0.0, atol=1e-15)
-    assert Likelihood(ptfe, model).observables == ["dop", "brdf"]  # q, u are opt-in
+    # by default the fullest observable measured: the Mueller matrix holds q, u and DOP, which are not counted again
+    lik = Likelihood(ptfe, model)
+    assert lik.observables[0] == "brdf" and lik.observables[1:] == [f"m{i}{j}" for i in range(1, 5) for j in range(1, 5)][1:]
+    assert lik.left_out == {"dop": "mueller", "stokes": "mueller"}
+    no_mueller = ptfe.select(np.arange(len(ptfe)))
+    no_mueller.mueller = None
+    assert Likelihood(no_mueller, model).observables == ["brdf", "q", "u"]  # q, u hold DOP (and AoP)
+    no_mueller.stokes = None
+    assert Likelihood(no_mueller, model).observables == ["dop", "brdf"]

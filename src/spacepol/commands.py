@@ -244,6 +244,9 @@ def run(args) -> int:
                 print(f"sampling {', '.join(posterior.names)} from {len(data)} geometries "
                       f"({', '.join(posterior.likelihood.observables)}), model {posterior.likelihood.model.name}",
                       file=sys.stderr)
+                if left_out := posterior.likelihood.left_out:
+                    print(f"  not fitted: {', '.join(left_out)} ({' and '.join(sorted(set(left_out.values())))} holds "
+                          f"their numbers; --observables chooses)", file=sys.stderr)
             if args.restart and (old := set_aside(chain)) is not None and not args.quiet:
                 print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
             inv = invert(posterior, seed=args.seed, walkers=args.walkers, max_steps=args.steps,

@@ -7,7 +7,7 @@ import warnings
 import arviz as az
 import numpy as np
 
-from .inference_data import median_fit
+from .inference_data import median_fit, model_dop
 from .posterior import Posterior
 from .result import Result
 
@@ -53,11 +53,17 @@ def loo(idata) -> dict:
 
 
 def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:
-    """RMSE of DOP and reduced chi^2 at the posterior-median prediction."""
+    """RMSE of DOP (also when DOP is not fitted but measured: a Mueller fit predicts it) and reduced chi^2
+    at the posterior-median prediction."""
     lik = posterior.likelihood
     mu, scale = median_fit(posterior, result.flat_samples())
     chi2 = sum(float(np.sum(lik.standardise(o, mu[o], scale[o]) ** 2)) for o in lik.observables)
-    rmse = float(np.sqrt(np.mean((lik.data.dop - mu["dop"]) ** 2))) if "dop" in lik.observables else None
+    if "dop" in lik.observables:
+        rmse = float(np.sqrt(np.mean((lik.data.dop - mu["dop"]) ** 2)))
+    elif lik.data.dop is not None:
+        rmse = float(np.sqrt(np.mean((lik.data.dop - model_dop(posterior, result.flat_samples())) ** 2)))
+    else:
+        rmse = None
     dof = max(lik.n_obs - posterior.ndim, 1)
     return {"rmse_dop": rmse, "chi2_red": chi2 / dof, "elpd_loo": loo_result["elpd_loo"],
             "elpd_loo_se": loo_result["elpd_loo_se"]}

@@ -12,7 +12,17 @@ from .posterior import Posterior
 from .result import Result
 
 
-def _batched(fn, flat, batch=4096):
+# Numbers one batched model call may hold per array (parameter sets x geometries x 16 for a Mueller
+# matrix): ~32 MB, so large data sets are evaluated in pieces that stay in cache-friendly memory.
+_BATCH_VALUES = 4_000_000
+# Pointwise groups (log-likelihood, replicates) hold draws x observations numbers; above this many the
+# draws are thinned for them (never below _MIN_POINTWISE_DRAWS): PSIS-LOO needs hundreds of draws, not 10^4.
+_POINTWISE_VALUES = 40_000_000
+_MIN_POINTWISE_DRAWS = 800
+
+
+def _batched(fn, flat, points: int = 1):
+    batch = max(1, _BATCH_VALUES // (16 * max(points, 1)))
     return np.concatenate([fn(flat[i : i + batch]) for i in range(0, len(flat), batch)], axis=0)
 
 
@@ -26,8 +36,18 @@ def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
         pred = lik.predict(params)
         return np.stack([pred[o] for o in lik.observables], axis=0).transpose(1, 0, 2)
 
-    stacked = _batched(one, flat_theta)  # (S, n_observables, N)
+    stacked = _batched(one, flat_theta, len(lik.data))  # (S, n_observables, N)
     return {o: stacked[:, i, :] for i, o in enumerate(lik.observables)}
+
+
+def model_dop(posterior: Posterior, flat_theta, draws: int = 200) -> np.ndarray:
+    """Posterior-median model DOP at the data's geometries, also where DOP is not fitted (a Mueller fit
+    predicts it from its first column): (N,). Up to ``draws`` evenly thinned samples."""
+    lik, priors = posterior.likelihood, posterior.priors
+    names = {p.name for p in lik.model.parameters}
+    thinned = flat_theta[:: max(1, len(flat_theta) // draws)]
+    params = {k: v for k, v in priors.to_params(thinned).items() if k in names}
+    return np.median(np.atleast_2d(lik.model.evaluate(params, lik.geometry, check=False).dop), axis=0)
 
 
 def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
@@ -39,7 +59,9 @@ def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
 
 
 def median_fit(posterior: Posterior, samples):
-    """Posterior-median prediction and noise level per channel: ({ch: (N,)}, {ch: (N,)})."""
+    """Posterior-median prediction and noise level per channel: ({ch: (N,)}, {ch: (N,)}). On large data
+    sets from evenly thinned samples (``pointwise_thinning``)."""
+    samples = samples[:: pointwise_thinning(len(samples), 1, posterior.likelihood.n_obs)]
     means, scales = predictive_means(posterior, samples), noise_scales(posterior, samples)
     return ({o: np.median(m, axis=0) for o, m in means.items()}, {o: np.median(v, axis=0) for o, v in scales.items()})
 
@@ -59,15 +81,18 @@ def replicate(posterior: Posterior, means, scales, rng: np.random.Generator):
 def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Generator) -> az.InferenceData:
     samples = result.samples  # (draws, chains, D)
     draws, chains, ndim = samples.shape
-    flat = samples.transpose(1, 0, 2).reshape(-1, ndim)  # chain-major
-    loglik = _batched(posterior.log_prob_pointwise, flat)  # (S, M)
-    means = predictive_means(posterior, flat)
-    reps = replicate(posterior, means, noise_scales(posterior, flat), rng)
     lik = posterior.likelihood
     n = len(lik.data)
+    flat = samples.transpose(1, 0, 2).reshape(-1, ndim)  # chain-major
+    step = pointwise_thinning(draws, chains, lik.n_obs)
+    kept = draws if step == 1 else len(range(0, draws, step))
+    flat_kept = samples[::step].transpose(1, 0, 2).reshape(-1, ndim)
+    loglik = _batched(posterior.log_prob_pointwise, flat_kept, n)  # (S', M)
+    means = predictive_means(posterior, flat_kept)
+    reps = replicate(posterior, means, noise_scales(posterior, flat_kept), rng)
 
-    def shaped(a):
-        return a.reshape(chains, draws, *a.shape[1:])
+    def shaped(a, d=draws):
+        return a.reshape(chains, d, *a.shape[1:])
 
     geometry = {"theta_i": ("geometry", lik.data.theta_i), "theta_r": ("geometry", lik.data.theta_r),
                 "dphi": ("geometry", lik.data.dphi)}
@@ -75,8 +100,8 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
         warnings.filterwarnings("ignore", message="More chains")
         idata = az.from_dict(
             posterior={name: shaped(flat[:, j]) for j, name in enumerate(posterior.names)},
-            posterior_predictive={o: shaped(r) for o, r in reps.items()},
-            log_likelihood={"y": shaped(loglik)},
+            posterior_predictive={o: shaped(r, kept) for o, r in reps.items()},
+            log_likelihood={"y": shaped(loglik, kept)},
             sample_stats={"lp": shaped(result.log_prob.T.reshape(-1))},
             observed_data=lik.observed(),
             constant_data={k: v[1] for k, v in geometry.items()},
@@ -90,7 +115,17 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
         "thin": result.info.get("thin", 1), "steps": result.info.get("steps", draws),
     })
     idata.posterior_predictive.attrs["mean_prediction"] = "y_rep = model + noise drawn as in the likelihood"
+    for group in (idata.posterior_predictive, idata.log_likelihood):
+        group.attrs["every_kth_posterior_draw"] = step
     return idata
+
+
+def pointwise_thinning(draws: int, chains: int, n_obs: int) -> int:
+    """Every k-th draw for the pointwise groups: all of them unless draws x chains x observations exceeds
+    _POINTWISE_VALUES, and never fewer than _MIN_POINTWISE_DRAWS draws in all."""
+    total = draws * chains
+    step = max(1, int(np.ceil(total * n_obs / _POINTWISE_VALUES)))
+    return max(1, min(step, total // _MIN_POINTWISE_DRAWS))
 
 
 def for_storage(idata: az.InferenceData, max_values: int = 3_000_000) -> az.InferenceData:

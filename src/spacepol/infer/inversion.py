@@ -101,6 +101,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "seconds": time.perf_counter() - start,
         "seed": seed,
         "observables": posterior.likelihood.observables,
+        "observables_not_fitted": dict(posterior.likelihood.left_out),  # {name: the fitted observable holding it}
         "n_observations": posterior.likelihood.n_obs,
         "priors": posterior.priors.describe(),
         "fixed": {k: float(v) for k, v in posterior.priors.fixed.items()},

@@ -20,19 +20,15 @@ from ..io.measurements import Dataset
 from ..physics.model import Model
 from ..physics.parameter import Parameter
 
-DEFAULT_OBSERVABLES = obs.DEFAULT
-
-
 def select_observables(data: Dataset, names=None) -> list:
-    """The Observable objects to fit: those named (aliases such as q, u allowed), or by default DOP and
-    BRDF where present. Unknown, absent or repeated names are one-line errors."""
+    """The Observable objects to fit: those named (aliases such as q, u allowed), or by default every
+    observable in the data except those a fuller one contains (``observables.default_for``: the Mueller
+    matrix holds q, u, DOP and AoP). Unknown, absent or repeated names are one-line errors."""
     available = [o.name for o in obs.OBSERVABLES.values() if o.present(data)]
     if not names:
-        chosen = [obs.get(n) for n in DEFAULT_OBSERVABLES if n in available]
-        if not chosen:
-            raise ParameterError(f"{data.source}: no DOP or BRDF data to fit (it has {', '.join(available) or 'none'}; "
-                                 f"choose with --observables)")
-        return chosen
+        if not available:
+            raise ParameterError(f"{data.source}: no observable to fit (DOP, BRDF, Stokes, AoP or Mueller columns)")
+        return [obs.get(n) for n in obs.default_for(available)[0]]
     names = list(names)
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
@@ -51,6 +47,9 @@ class Likelihood:
     def __init__(self, data: Dataset, model: Model, observables=None, robust: bool = False, nu: float = 4.0):
         self.data, self.model = data, model
         self.objects = select_observables(data, observables)
+        # observables in the data not fitted because a fitted one holds their numbers: {name: holder}
+        self.left_out = {} if observables else obs.default_for([o.name for o in obs.OBSERVABLES.values()
+                                                                 if o.present(data)])[1]
         self.observable_names = [o.name for o in self.objects]
         self.needs_mueller = any(o.needs_mueller for o in self.objects)
         self._owner, self._y, self._errors = {}, {}, {}

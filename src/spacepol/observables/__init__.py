@@ -13,7 +13,14 @@ from .stokes import Stokes
 OBSERVABLES: dict[str, Observable] = {o.name: o for o in (DOP(), BRDF(), AoP(), Stokes(), Mueller())}
 # channel names accepted where an observable is meant (``--observables q,u`` as before)
 ALIASES = {"q": "stokes", "u": "stokes"}
-DEFAULT = ("dop", "brdf")
+
+
+def default_for(present: list[str]) -> tuple[list[str], dict[str, str]]:
+    """Every present observable except those another present one contains (each measured number is
+    counted once): ``(chosen, {left out: the observable holding it})``. BRDF is always independent."""
+    chosen = [n for n in present if not any(n in OBSERVABLES[h].contains for h in present)]
+    left_out = {n: next(h for h in chosen if n in OBSERVABLES[h].contains) for n in present if n not in chosen}
+    return chosen, left_out
 
 
 def get(name: str) -> Observable:
@@ -23,4 +30,4 @@ def get(name: str) -> Observable:
     return OBSERVABLES[key]
 
 
-__all__ = ["OBSERVABLES", "Observable", "get", "DEFAULT"]
+__all__ = ["OBSERVABLES", "Observable", "get", "default_for"]

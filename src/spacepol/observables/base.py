@@ -26,6 +26,10 @@ class Observable:
     label: str = ""  # axis label
     needs_mueller: bool = False  # predictions need the model's full Mueller matrix
     noise: Parameter | None = None  # the nuisance noise level of the channel group when the file gives none
+    # observables whose numbers this one already holds (the normalised Mueller matrix's first column is
+    # the Stokes vector, which gives DOP and AoP): by default only the fullest of them is fitted, so no
+    # measured number is counted twice
+    contains: tuple[str, ...] = ()
 
     def present(self, data) -> bool:
         raise NotImplementedError

@@ -40,6 +40,7 @@ class Mueller(Observable):
     channels = ELEMENTS
     label = "m_ij = M_ij / M_11"
     needs_mueller = True
+    contains = ("stokes", "dop", "aop")  # m21, m31, m41 are S1, S2, S3 / S0 for unpolarized incidence
 
     def present(self, data):
         return data.mueller is not None

@@ -20,6 +20,7 @@ class Stokes(Observable):
     name = "stokes"
     channels = ("q", "u")
     label = "normalised Stokes"
+    contains = ("dop", "aop")
     noise = Parameter("sigma_qu", "", LogUniform(1e-4, 0.5), 0.01,
                       "noise of the normalised Stokes parameters q, u (inferred)", physical=(1e-12, np.inf))
 

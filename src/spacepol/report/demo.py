@@ -2,8 +2,8 @@
 
 1. Forward model on the geometry of NIST's measured PTFE Mueller BRDF (0.633 um, plane of
    incidence): ``ptfe_forward.csv``, ``ptfe_dop.png``.
-2. Bayesian inversion of that measurement (DOP and BRDF) with the paper's model, compared with
-   PTFE's known bulk index (about 1.35): ``ptfe_paper/``.
+2. Bayesian inversion of that measurement (the 15 normalised Mueller elements and the BRDF) with the
+   paper's model, compared with PTFE's known bulk index (about 1.35): ``ptfe_paper/``.
 3. Model criticism on a bundled synthetic set with a hidden effect: fit -> diagnose -> ladder
    (``hidden/``), then the hidden truth revealed.
 4. The same on PTFE (``ptfe_diagnose/``, ``ptfe_ladder/``): which effects improve ELPD-LOO by
@@ -125,6 +125,15 @@ def _criticism_section(report, rungs, folder: str) -> str:
             + f'<p><a href="{Path(folder).name}/diagnose/report.html">Full diagnosis</a></p>')
 
 
+def _noise_words(summary) -> str:
+    """'sigma_m_pol 0.0075, ..., sigma_brdf_rel 32 %': the inferred noise levels, medians."""
+    words = []
+    for name, q in summary["parameters"].items():
+        if name.startswith("sigma_"):
+            words.append(f"{name} {100 * q['median']:.0f} %" if name.endswith("_rel") else f"{name} {q['median']:.4f}")
+    return ", ".join(words) or "none (the file gives errors)"
+
+
 def hidden_truth(metadata: dict) -> dict:
     """What synth hid: the effects beyond the paper's model and their values (from the file header)."""
     model = metadata.get("model", "")
@@ -151,7 +160,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
     for line in forward_lines:
         print("   " + line)
 
-    print("2/5 inversion of the PTFE measurement (DOP + BRDF) with the paper's model")
+    print("2/5 inversion of the PTFE measurement (full Mueller matrix + BRDF) with the paper's model")
     posterior = Posterior.build(data, Model.from_string("paper"))
     inv = invert(posterior, seed=seed, backend_path=None, progress=True)
     summary = write_run_report(inv, out / "ptfe_paper", f"{source} (0.633 um, in-plane)", references={"n": PTFE_INDEX})
@@ -187,15 +196,15 @@ def run_demo(out: Path, seed: int = 0) -> None:
     sections = [
         ("What this is", H.paragraph(
             "spacepol's demo on NIST's measured Mueller-matrix BRDF of sintered PTFE (Germer, Appl. Opt. 56, 2017), "
-            "0.633 um, plane of incidence: the forward model, a Bayesian inversion of DOP and BRDF, then model criticism "
+            "0.633 um, plane of incidence: the forward model, a Bayesian inversion of the measured Mueller matrix "
+            "(15 normalised elements) and BRDF, then model criticism "
             "(what is missing from the paper's model, and the error falling as it is added), first on a synthetic set "
             "with a known hidden effect, then on PTFE.")),
         ("1. Forward model", H.bullets(forward_lines) + H.image(H.png_file_to_data_uri(out / "ptfe_dop.png"))),
         ("2. Inversion with the paper's model", H.bullets(
             [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
-             f"ESS min {d['ess_min']:.0f}; inferred noise: DOP {summary['parameters']['sigma_dop']['median']:.4f}, "
-             f"BRDF {100 * summary['parameters']['sigma_brdf_rel']['median']:.0f} % (with inferred noise, reduced chi^2 "
-             f"is ~1 by construction)."]
+             f"ESS min {d['ess_min']:.0f}; inferred noise: {_noise_words(summary)} (with inferred noise, reduced "
+             f"chi^2 is ~1 by construction)."]
             + [summary["references"]["n"]["explanation"]] + summary["residual_structure"]["findings"]
             + summary["identifiability"]["findings"])
          + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'

@@ -69,11 +69,14 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
     with atomic_path(out / "posterior.nc") as tmp:
         for_storage(inv.idata).to_netcdf(str(tmp))
     write_json(out / "summary.json", summary)
-    write_text(out / "report.html", _html(inv, data_path, figures, truths, notes or []))
+    write_text(out / "report.html", _html(inv, data_path, out, figures, truths, notes or []))
     return summary
 
 
-def _html(inv, data_path, figures, truths, notes) -> str:
+def _html(inv, data_path, out, figures, truths, notes) -> str:
+    def png(name):  # the saved file, embedded (drawing a figure again costs as much as the first time)
+        return H.png_file_to_data_uri(out / name)
+
     s = inv.summary
     diag, fit = s["diagnostics"], s["fit"]
     rows = []
@@ -107,14 +110,14 @@ def _html(inv, data_path, figures, truths, notes) -> str:
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
                         + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
          + H.bullets(s["residual_structure"]["findings"])
-         + H.image(H.figure_to_data_uri(figures["fit.png"]), "Data, posterior median and 90 % band of the prediction, "
+         + H.image(png("fit.png"), "Data, posterior median and 90 % band of the prediction, "
                    "per observable (rows) and incidence angle (columns).")
-         + H.image(H.figure_to_data_uri(figures["residuals.png"]), "Standardised residuals; dotted lines at +-2.")
-         + (H.image(H.figure_to_data_uri(figures["residuals_mueller.png"]), "Residuals laid out as the Mueller matrix.")
+         + H.image(png("residuals.png"), "Standardised residuals; dotted lines at +-2.")
+         + (H.image(png("residuals_mueller.png"), "Residuals laid out as the Mueller matrix.")
             if "residuals_mueller.png" in figures else "")
-         + H.image(H.figure_to_data_uri(figures["residual_trends.png"]),
+         + H.image(png("residual_trends.png"),
                    "Residuals against each angle and the DOP level, with Spearman's rho (red: p < 0.01).")),
-        ("Posterior", H.image(H.figure_to_data_uri(figures["corner.png"]), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),
+        ("Posterior", H.image(png("corner.png"), "Corner plot; 5/50/95 % quantiles; truths in red when known.")),
     ]
     if notes:
         sections.insert(4, ("Notes", H.bullets(notes)))

@@ -67,3 +67,38 @@ def test_a_cauchy_law_is_recovered_from_four_wavelengths(cauchy_fit):
         q = derived[f"n@{lam:g}"]
         assert q["q05"] <= TRUTH["n_cauchy_a"] + TRUTH["n_cauchy_b"] / lam**2 <= q["q95"], (lam, q)
     assert not p["n_cauchy_b"]["q05"] <= 0.02 <= p["n_cauchy_b"]["q95"]
+
+
+def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per_wavelength():
+    """diagnose and its changes work on a joint fit over wavelengths: the change is made to the inner
+    model, the candidates keep n@LAMBDA, and a hidden Lambertian term is named (a null set names none)."""
+    from spacepol.criticism.changes import parse
+    from spacepol.criticism.diagnose import diagnose
+
+    lams = [0.532, 1.064]
+    truth = {"n@0.532": 1.5, "n@1.064": 1.45, "k@0.532": 0.0, "k@1.064": 0.0, "sigma": 0.2, "ks": 0.6, "rho_l": 0.25}
+    ti0, tr0 = np.meshgrid([20.0, 45.0, 65.0], np.linspace(0.0, 80.0, 9), indexing="ij")
+    ti, tr = np.tile(ti0.ravel(), 2), np.tile(tr0.ravel(), 2)
+    wl = np.repeat(lams, ti0.size)
+    g = Geometry(ti, tr, np.full(ti.size, 180.0), wl)
+    base = SpectralModel(Model.from_string("specular+smith"), lams)
+    changed = parse(base, "lambertian").model
+    assert isinstance(changed, SpectralModel) and changed.name == "specular+smith+lambertian"
+    assert {"n@0.532", "n@1.064", "rho_l"} <= {p.name for p in changed.parameters}
+    rng = np.random.default_rng(4)
+
+    def render(model, values):
+        pred = model.evaluate(values, g)
+        d = Dataset(ti, tr, np.full(ti.size, 180.0), wavelength_um=wl)
+        d.dop, d.dop_err = np.clip(pred.dop + 0.004 * rng.standard_normal(g.size), 0, 1), np.full(g.size, 0.004)
+        d.brdf = pred.brdf * (1 + 0.02 * rng.standard_normal(g.size))
+        d.brdf_err = 0.02 * pred.brdf
+        d.source = "synthetic two-wavelength set"
+        return d
+
+    hidden = diagnose(render(changed, truth), base, np.random.default_rng(0), candidates=["lambertian", "oxide_layer"], top=1)
+    assert hidden["verdict"] == "lambertian", hidden["ranking"][:2]
+    assert "n@1.064" in hidden["_base"].summary["parameters"]
+    null = diagnose(render(base, {k: v for k, v in truth.items() if k != "rho_l"}), base, np.random.default_rng(0),
+                    candidates=["lambertian", "oxide_layer"], top=1)
+    assert null["verdict"] == "none", null["ranking"][:2]

@@ -338,13 +338,14 @@ def diagnose(args) -> int:
 
     check_output_file(args.json, "--json")
     check_output_dir(args.out)
-    model = build_model(args.model)
+    build_model(args.model)  # a wrong name fails before the data are read
     priors = read_prior_file(args.prior) if args.prior else None
     for name in args.candidates or []:
         registry.get(name)
     if args.top < 1:
         raise ParameterError(f"--top {args.top}: need at least 1")
     data = load_dataset(args)
+    model = model_for(args, data)  # over several wavelengths: n, k per wavelength
     observables = parse_observables(args.observables)
     rng = np.random.default_rng(args.seed)
     if args.rounds:
@@ -392,6 +393,7 @@ def ladder(args) -> int:
     for step in steps:  # check the whole ladder composes before fitting anything
         current = parse(current, step).model
     data = load_dataset(args)
+    model = model_for(args, data)
     observables = parse_observables(args.observables)
     rungs = climb(data, model, steps, seed=args.seed, observables=observables)
     out = Path(args.out)

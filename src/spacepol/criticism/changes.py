@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import SpacepolError
 from ..physics.model import Model
 from ..physics.registry import registry
+from ..physics.spectral import SpectralModel
 
 
 @dataclass
@@ -36,7 +37,10 @@ class Change:
 
 
 def apply(model: Model, label: str) -> Model:
-    """The model after a change written as ``add E``, ``replace A by B`` or ``remove E``."""
+    """The model after a change written as ``add E``, ``replace A by B`` or ``remove E``. Over several
+    wavelengths the change is made to the inner model, kept over the same wavelengths."""
+    if isinstance(model, SpectralModel):
+        return model.with_model(apply(model.model, label))
     words = label.split()
     try:
         if words[0] == "add" and len(words) == 2:
@@ -138,11 +142,13 @@ def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
                 continue
             lo, hi = posterior.priors.priors[name].bounds
             default = params[name].default if name in params else 0.5 * (lo + hi)
-            refined = effect.splits.get(name) if change.kind != "remove" else None
+            bare, at, label = name.partition("@")  # n_film@0.633 refines n@0.633 over several wavelengths
+            refined = effect.splits.get(bare) if change.kind != "remove" else None
+            refined = f"{refined}{at}{label}" if refined else None
             if refined in base_best:
                 row.append(base_best[refined])
             else:
-                row.append([effect.neutral.get(name, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][option])
+                row.append([effect.neutral.get(bare, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][option])
         rows.append(row)
     bounds = posterior.priors.bounds
     return np.clip(np.array(rows, float), bounds[:, 0], bounds[:, 1])

@@ -12,17 +12,13 @@ from .posterior import Posterior
 from .result import Result
 
 
-# Numbers one batched model call may hold per array (parameter sets x geometries x 16 for a Mueller
-# matrix): ~32 MB, so large data sets are evaluated in pieces that stay in cache-friendly memory.
-_BATCH_VALUES = 4_000_000
 # Pointwise groups (log-likelihood, replicates) hold draws x observations numbers; above this many the
 # draws are thinned for them (never below _MIN_POINTWISE_DRAWS): PSIS-LOO needs hundreds of draws, not 10^4.
 _POINTWISE_VALUES = 40_000_000
 _MIN_POINTWISE_DRAWS = 800
 
 
-def _batched(fn, flat, points: int = 1):
-    batch = max(1, _BATCH_VALUES // (16 * max(points, 1)))
+def _batched(fn, flat, batch: int):
     return np.concatenate([fn(flat[i : i + batch]) for i in range(0, len(flat), batch)], axis=0)
 
 
@@ -36,7 +32,7 @@ def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
         pred = lik.predict(params)
         return np.stack([pred[o] for o in lik.observables], axis=0).transpose(1, 0, 2)
 
-    stacked = _batched(one, flat_theta, len(lik.data))  # (S, n_observables, N)
+    stacked = _batched(one, flat_theta, lik.batch_sets)  # (S, n_observables, N)
     return {o: stacked[:, i, :] for i, o in enumerate(lik.observables)}
 
 
@@ -87,7 +83,7 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
     step = pointwise_thinning(draws, chains, lik.n_obs)
     kept = draws if step == 1 else len(range(0, draws, step))
     flat_kept = samples[::step].transpose(1, 0, 2).reshape(-1, ndim)
-    loglik = _batched(posterior.log_prob_pointwise, flat_kept, n)  # (S', M)
+    loglik = _batched(posterior.log_prob_pointwise, flat_kept, lik.batch_sets)  # (S', M)
     means = predictive_means(posterior, flat_kept)
     reps = replicate(posterior, means, noise_scales(posterior, flat_kept), rng)
 

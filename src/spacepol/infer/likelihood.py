@@ -75,6 +75,12 @@ class Likelihood:
                        for ch in self.observables for i in range(len(data))]
 
     @property
+    def batch_sets(self) -> int:
+        """How many parameter sets one vectorised evaluation should take: intermediate arrays of
+        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB)."""
+        return max(1, 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data)))
+
+    @property
     def n_obs(self) -> int:
         return len(self.observables) * len(self.data)
 

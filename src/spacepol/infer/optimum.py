@@ -68,7 +68,8 @@ def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 819
         return objective(priors.rescale(np.clip(u, 0.0, 1.0)))
 
     u = qmc.Sobol(priors.ndim, rng=np.random.default_rng(rng.integers(2**63))).random(points)
-    values = np.concatenate([f(u[i : i + 4096]) for i in range(0, points, 4096)])
+    batch = posterior.likelihood.batch_sets
+    values = np.concatenate([f(u[i : i + batch]) for i in range(0, points, batch)])
     starts = u[np.argsort(values)[:polish]]
     best_value, best_u = np.inf, starts[0]
     for start in starts:

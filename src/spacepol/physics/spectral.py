@@ -57,6 +57,16 @@ class SpectralModel:
     def name(self) -> str:
         return self.model.name
 
+    def __repr__(self):
+        return f"SpectralModel('{self.name}' at {', '.join(self.labels)} um)"
+
+    def with_model(self, model: Model) -> "SpectralModel":
+        """Another inner model over the same wavelengths and dispersion laws (a criticism change applied)."""
+        return SpectralModel(model, self.wavelengths, self.dispersion)
+
+    def __add__(self, other):
+        return self.with_model(self.model + other)
+
     @property
     def effects(self):
         return self.model.effects

@@ -90,6 +90,20 @@ def test_log_density_equals_a_direct_computation(name):
     assert not np.allclose(lik.pointwise(shifted)[0], want)
 
 
+def test_inferred_aop_noise_grows_as_one_over_the_measured_dop():
+    """Without aop_err, the AoP's noise is sigma_aop_deg / max(DOP, 0.05) per row (a polarimeter's q, u noise
+    seen through AoP = atan2(u, q) / 2); negative control: the constant-noise density differs."""
+    data, g = _data(np.random.default_rng(3))
+    data.aop_err = None
+    lik = Likelihood(data, Model.from_string(MODEL), observables=["aop"])
+    params = {**{k: np.array([v]) for k, v in OTHER.items()}, "sigma_aop_deg": np.array([0.8])}
+    p = Model.from_string(MODEL).evaluate(OTHER, g)
+    resid = (data.aop - 0.5 * np.degrees(np.arctan2(p.stokes[2], p.stokes[1])) + 90.0) % 180.0 - 90.0
+    scale = 0.8 / np.maximum(data.dop, 0.05)
+    np.testing.assert_allclose(lik.pointwise(params)[0], _gauss(resid, scale), rtol=1e-10, atol=1e-10)
+    assert data.dop.min() < 0.5 and not np.allclose(lik.pointwise(params)[0], _gauss(resid, np.full(g.size, 0.8)))
+
+
 def test_observables_declare_their_channels_and_noise():
     data, _ = _data(np.random.default_rng(3))
     lik = Likelihood(data, Model.from_string(MODEL), observables=["mueller", "brdf"])

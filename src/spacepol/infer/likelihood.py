@@ -52,13 +52,16 @@ class Likelihood:
                                                                  if o.present(data)])[1]
         self.observable_names = [o.name for o in self.objects]
         self.needs_mueller = any(o.needs_mueller for o in self.objects)
-        self._owner, self._y, self._errors = {}, {}, {}
+        self._owner, self._y, self._errors, self._profile = {}, {}, {}, {}
         self.nuisance: list[Parameter] = []
         for o in self.objects:
             observed, errors = o.observed(data), o.errors(data)
             for ch in o.channels:
                 self._owner[ch], self._y[ch] = o, np.asarray(observed[ch], float)
                 if errors is None:
+                    profile = o.noise_profile(ch, data)
+                    if profile is not None:
+                        self._profile[ch] = np.asarray(profile, float)
                     if o.noise_parameter(ch) not in self.nuisance:
                         self.nuisance.append(o.noise_parameter(ch))
                     continue
@@ -105,10 +108,12 @@ class Likelihood:
         return channel not in self._errors
 
     def scale(self, channel: str, params: dict | None = None):
-        """The channel's noise: the file's errors (N,), or the nuisance level per parameter set (P, 1)."""
+        """The channel's noise: the file's errors (N,), or the nuisance level per parameter set (P, 1), times
+        the observable's profile over the rows (P, N) where it has one (AoP's 1 / DOP)."""
         if channel in self._errors:
             return self._errors[channel]
-        return np.asarray(params[self.noise_parameter(channel)])[:, None]
+        level = np.asarray(params[self.noise_parameter(channel)])[:, None]
+        return level * self._profile[channel] if channel in self._profile else level
 
     def residual(self, channel: str, mu):
         """Measured minus predicted in the space where the channel's noise is Gaussian."""

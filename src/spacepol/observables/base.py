@@ -58,6 +58,10 @@ class Observable:
         """Replicate data drawn like the measurement: prediction plus noise in the residual's space."""
         return mu + scale * rng.standard_normal(np.shape(mu))
 
+    def noise_profile(self, channel: str, data) -> np.ndarray | None:
+        """How an inferred noise level varies over the rows: (N,) factors on it, or None for a constant level."""
+        return None
+
     def noise_parameter(self, channel: str) -> Parameter:
         """The nuisance parameter holding ``channel``'s noise level when the file gives no errors."""
         return self.noise

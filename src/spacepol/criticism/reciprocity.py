@@ -1,0 +1,86 @@
+"""Reciprocity (Helmholtz): swapping source and detector leaves a BRDF unchanged and transposes its
+Mueller matrix. In spacepol's frames (DESIGN.md, "Geometry convention") for an isotropic surface
+
+    M(theta_r -> theta_i, dphi) = D M(theta_i -> theta_r, dphi)^T D,   D = diag(1, 1, 1, -1),
+
+which the exact Fresnel facet lobe satisfies to rounding (tested), as do SCATMECH's reciprocal models.
+A model term that breaks it (the paper's cos(theta_r) body term, its shadowing function) cannot be the
+physics of a passive surface; measured data that break it beyond their noise point to an instrument
+or alignment error. Germer's PTFE set is reciprocal by construction of his measurement (Appl. Opt. 56,
+9333, 2017); here it is checked on the rows whose swapped geometry was also measured.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..physics.geometry import Geometry
+
+D = np.diag([1.0, 1.0, 1.0, -1.0])
+
+
+def reciprocal_image(mueller) -> np.ndarray:
+    """D M^T D for (4, 4, ...) Mueller arrays: what the swapped geometry must measure."""
+    return np.einsum("ij,jk...,kl->il...", D, np.swapaxes(mueller, 0, 1), D)
+
+
+def swapped(geometry: Geometry) -> Geometry:
+    return Geometry(geometry.theta_r, geometry.theta_i, geometry.dphi, geometry.wavelength_um)
+
+
+def model_violation(model, params: dict, geometry: Geometry, max_angle_deg: float = 89.0) -> dict:
+    """How far ``model`` at ``params`` is from reciprocal at the geometries (those whose swapped incidence
+    angle is below ``max_angle_deg``): the relative BRDF change |f(r->i) / f(i->r) - 1| and the largest
+    normalised element difference max_ij |m(r->i) - (D m(i->r)^T D)|, as median and 95th percentile."""
+    keep = geometry.theta_r < max_angle_deg
+    geo = Geometry(geometry.theta_i[keep], geometry.theta_r[keep], geometry.dphi[keep],
+                   None if geometry.wavelength_um is None else geometry.wavelength_um[keep])
+    forward = model.evaluate(params, geo, mueller=True, check=False).mueller
+    backward = model.evaluate(params, swapped(geo), mueller=True, check=False).mueller
+    return _compare(forward, backward)
+
+
+def _compare(forward, backward) -> dict:
+    f0, b0 = forward[0, 0], backward[0, 0]
+    ok = (f0 > 0) & (b0 > 0)
+    brdf = np.abs(b0[ok] / f0[ok] - 1.0)
+    image = reciprocal_image(forward[..., ok] / f0[ok])
+    elements = np.max(np.abs(backward[..., ok] / b0[ok] - image), axis=(0, 1))
+    return {"brdf_relative_median": float(np.median(brdf)), "brdf_relative_p95": float(np.percentile(brdf, 95)),
+            "element_median": float(np.median(elements)), "element_p95": float(np.percentile(elements, 95)),
+            "n_geometries": int(ok.sum())}
+
+
+def data_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
+    (theta_i and theta_r exchanged, same dphi and wavelength). a = b where theta_i = theta_r: reciprocity
+    then constrains the matrix itself (m12 = m21, m14 = -m41, ...)."""
+    wl = np.zeros(len(data)) if data.wavelength_um is None else data.wavelength_um
+    key = {}
+    for j in range(len(data)):
+        key.setdefault(_rounded(data.theta_i[j], data.theta_r[j], data.dphi[j], wl[j], tolerance_deg), []).append(j)
+    pairs = []
+    for j in range(len(data)):
+        for k in key.get(_rounded(data.theta_r[j], data.theta_i[j], data.dphi[j], wl[j], tolerance_deg), []):
+            if j <= k:
+                pairs.append((j, k))
+    return np.array(pairs, int).reshape(-1, 2)
+
+
+def _rounded(ti, tr, dphi, wl, tol):
+    # NIST's file stores normal incidence as 0.001 deg and normal reflection as 0: both are 0 here
+    ti, tr = (0.0 if abs(ti) < 0.01 else ti), (0.0 if abs(tr) < 0.01 else tr)
+    return (round(ti / tol), round(tr / tol), round(((dphi + 180.0) % 360.0 - 180.0) / tol), round(wl * 1e4))
+
+
+def data_violation(data, pairs: np.ndarray | None = None) -> dict:
+    """Reciprocity of the measurement itself on its swapped pairs (``data_pairs``): the BRDF's relative
+    difference and the normalised elements' largest difference per pair, median and 95th percentile.
+    Needs the Mueller matrix."""
+    pairs = data_pairs(data) if pairs is None else pairs
+    if len(pairs) == 0 or data.mueller is None:
+        return {"n_pairs": int(len(pairs))}
+    forward, backward = data.mueller[..., pairs[:, 0]], data.mueller[..., pairs[:, 1]]  # sr^-1 (M_11 = BRDF)
+    out = _compare(forward, backward)
+    out.update({"n_pairs": int(len(pairs)), "n_self_pairs": int(np.sum(pairs[:, 0] == pairs[:, 1]))})
+    return out

@@ -2,7 +2,10 @@
 sintered PTFE (T. A. Germer, Appl. Opt. 56, 9333, 2017), the whole file: every geometry, every
 wavelength, all 15 normalised Mueller elements and the BRDF.
 
-    python studies/ptfe_study.py [--wavelength-um all] [--rounds 3] [--top 1] [--seed 0] [--out reports/ptfe]
+    python studies/ptfe_study.py [--wavelength-um all] [--rounds 3] [--top 1] [--joint all] [--seed 0] [--out reports/ptfe]
+
+``--joint all`` refits the loop's first and last models jointly over those wavelengths (n per wavelength,
+geometry shared) after a loop run at fewer wavelengths (a loop at all four costs about an hour a round here).
 
 1. The data's own reciprocity on the rows whose swapped geometry was measured (criticism/reciprocity.py).
 2. The criticism loop from the paper's model (diagnose, one round at a time, continuing from the change
@@ -172,10 +175,11 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     return out
 
 
-def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool) -> None:
-    write_json(out / "study.json", {"meta": meta, "data_reciprocity": data_recip, "rounds": rungs, "complete": done})
+def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=()) -> None:
+    write_json(out / "study.json", {"meta": meta, "data_reciprocity": data_recip, "rounds": rungs, "joint": list(joint),
+                                    "complete": done})
     save_figure(rounds_figure(rungs), out / "rounds.png")
-    save_figure(index_figure(rungs), out / "n_lambda.png")
+    save_figure(index_figure(list(joint) or rungs), out / "n_lambda.png")
     save_figure(structure_figure(rungs), out / "residual_structure.png")
     plt.close("all")
     lines = [f"# PTFE study: {meta['data']}", "",
@@ -183,7 +187,9 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
              f"{'complete' if done else 'PARTIAL: interrupted or still running'}.", "",
              f"{meta['rows']} geometries x ({', '.join(meta['observables'])}) = {meta['numbers']} measured numbers at "
              f"{meta['wavelengths']} um. {SOURCE}.", "",
-             "## Findings", ""] + [f"- {f}" for f in findings(rungs, data_recip)] + [
+             "## Findings", ""] + [f"- {f}" for f in findings(rungs, data_recip)] + (
+             [f"- Jointly over {meta['joint_wavelengths']} um ({joint[-1]['model']}): " + findings(joint, data_recip)[0]]
+             if joint else []) + [
              "", "## Rounds", "",
              "| round | change | delta ELPD | ELPD-LOO | inferred noise | n(lambda) median | at bound | reciprocity (BRDF median, elements p95) |",
              "|---|---|---|---|---|---|---|---|"]
@@ -194,6 +200,13 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
         rec = r["reciprocity"]
         lines.append(f"| {i} | {r['change'] or r['model']} | {delta} | {r['elpd_loo']:.0f} +- {r['elpd_loo_se']:.0f} | {noise} | {n} | "
                      f"{'; '.join(r['at_bound']) or 'none'} | {100 * rec['brdf_relative_median']:.1f} %, {rec['element_p95']:.3f} |")
+    if joint:
+        lines += ["", f"## The first and last models jointly over {meta['joint_wavelengths']} um", "",
+                  "| model | ELPD-LOO | inferred noise | n(lambda): median [90 %] | at bound |", "|---|---|---|---|---|"]
+        for r in joint:
+            noise = ", ".join(f"{k} {v:.3g}" for k, v in r["inferred_noise"].items())
+            n = ", ".join(f"{lab}: {q['median']:.3f} [{q['q05']:.3f}, {q['q95']:.3f}]" for lab, q in r["n"].items())
+            lines.append(f"| {r['model']} | {r['elpd_loo']:.0f} +- {r['elpd_loo_se']:.0f} | {noise} | {n} | {'; '.join(r['at_bound']) or 'none'} |")
     lines += ["", "![rounds](rounds.png)", "", "![n(lambda)](n_lambda.png)", "", "![residual structure](residual_structure.png)", "",
               "![final residuals as the Mueller matrix](final_residuals_mueller.png)", ""]
     write_text(out / "report.md", "\n".join(lines) + "\n")
@@ -205,6 +218,7 @@ def main(argv=None) -> int:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--top", type=int, default=1, help="candidates confirmed by emcee per round")
     parser.add_argument("--model", default="paper", help="where the loop starts")
+    parser.add_argument("--joint", default=None, metavar="all|LIST", help="refit the first and last models jointly here")
     parser.add_argument("--in-plane", action="store_true", help="the plane of incidence only (a quick look, not the study)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="reports/ptfe")
@@ -237,10 +251,24 @@ def main(argv=None) -> int:
                 "minutes": (time.perf_counter() - start) / 60, "machine": "2 cores", "rows": len(data),
                 "observables": observables, "numbers": len(data) * len(observables),
                 "wavelengths": ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))}
-        write_report(out, meta, rungs, data_recip, done or r == args.rounds - 1)
+        write_report(out, meta, rungs, data_recip, (done or r == args.rounds - 1) and not args.joint)
         print(f"round {r + 1}: {rungs[-1]['change'] or 'no change'}; report rewritten in {out}", file=sys.stderr)
         if done:
             break
+    if args.joint:
+        from spacepol.infer.inversion import invert
+        from spacepol.infer.posterior import Posterior
+
+        joint_data = load(args.joint, args.in_plane)
+        meta["joint_wavelengths"] = ", ".join(f"{w:g}" for w in np.unique(joint_data.wavelength_um))
+        joint = []
+        for spec in dict.fromkeys([rungs[0]["model"], rungs[-1]["model"]]):
+            print(f"joint fit of {spec} over {meta['joint_wavelengths']} um ({len(joint_data)} geometries)", file=sys.stderr)
+            inv = invert(Posterior.build(joint_data, model_for(joint_data, spec)), seed=args.seed, progress=False)
+            joint.append(rung_record({"model": spec, "change": f"joint: {spec}", "delta_elpd": None, "delta_elpd_se": None},
+                                     inv, joint_data))
+            meta["minutes"] = (time.perf_counter() - start) / 60
+            write_report(out, meta, rungs, data_recip, len(joint) == 2 or rungs[0]["model"] == rungs[-1]["model"], joint)
     return 0
 
 

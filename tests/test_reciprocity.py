@@ -1,5 +1,5 @@
-"""Reciprocity (issue 11, item 4): the relation M(r -> i) = D M(i -> r)^T D, D = diag(1, 1, 1, -1), in
-spacepol's frames is checked on NIST SCATMECH's reciprocal facet model (an independent implementation),
+"""Reciprocity (issue 11, item 4): the relation M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q, Q = diag(1, 1, -1, 1),
+in spacepol's frames is checked on NIST SCATMECH's reciprocal facet model (an independent implementation),
 then used to measure models and measured pairs."""
 
 import numpy as np
@@ -18,7 +18,8 @@ def _random_geometry(n=40, seed=0):
 
 def test_scatmech_facet_model_obeys_the_relation_in_spacepols_frames():
     """SCATMECH's Facet_BRDF_Model (absorbing substrate, so the circular elements are non-zero) at swapped
-    geometries: D M^T D with D = diag(1, 1, 1, -1) to rounding; the other candidate diag(1, 1, -1, 1) fails."""
+    geometries (dphi -> -dphi): Q M^T Q with Q = diag(1, 1, -1, 1) to rounding; the other sign convention,
+    diag(1, 1, 1, -1), fails."""
     from pySCATMECH.brdf import BRDF_Model
 
     model = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": "(1.2,6.0)", "type": 0,
@@ -30,9 +31,9 @@ def test_scatmech_facet_model_obeys_the_relation_in_spacepols_frames():
 
     worst, wrong = 0.0, 0.0
     for ti, tr, dphi in zip(g.theta_i, g.theta_r, g.dphi):
-        forward, backward = at(ti, tr, dphi), at(tr, ti, dphi)
+        forward, backward = at(ti, tr, dphi), at(tr, ti, -dphi)
         worst = max(worst, np.max(np.abs(reciprocity.reciprocal_image(forward) - backward)) / forward[0, 0])
-        other = np.diag([1.0, 1, -1, 1])
+        other = np.diag([1.0, 1, 1, -1])
         wrong = max(wrong, np.max(np.abs(other @ forward.T @ other - backward)) / forward[0, 0])
     assert worst < 1e-9 and wrong > 0.05
 
@@ -57,7 +58,7 @@ def test_measured_pairs_are_found_and_compared():
     a reciprocal set shows no violation, one with a transposed element sign broken does."""
     ti = np.array([30.0, 45.0, 30.0, 20.0])
     tr = np.array([45.0, 30.0, 30.0, 60.0])
-    dphi = np.array([150.0, 150.0, 120.0, 180.0])
+    dphi = np.array([150.0, -150.0, 180.0, 180.0])
     g = Geometry(ti, tr, dphi)
     model = Model.from_string("specular+smith")
     data = Dataset(ti, tr, dphi)

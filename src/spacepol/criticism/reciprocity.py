@@ -1,9 +1,12 @@
 """Reciprocity (Helmholtz): swapping source and detector leaves a BRDF unchanged and transposes its
-Mueller matrix. In spacepol's frames (DESIGN.md, "Geometry convention") for an isotropic surface
+Mueller matrix. Swapped, the source sits at the detector's azimuth, so dphi changes sign; in spacepol's
+frames (DESIGN.md, "Geometry convention")
 
-    M(theta_r -> theta_i, dphi) = D M(theta_i -> theta_r, dphi)^T D,   D = diag(1, 1, 1, -1),
+    M(theta_r -> theta_i, -dphi) = Q M(theta_i -> theta_r, dphi)^T Q,   Q = diag(1, 1, -1, 1),
 
-which the exact Fresnel facet lobe satisfies to rounding (tested), as do SCATMECH's reciprocal models.
+which SCATMECH's reciprocal facet model satisfies to rounding (tested), as do spacepol's reciprocal effects.
+(On an isotropic surface, mirror symmetry M(-dphi) = diag(1, 1, -1, -1) M(dphi) diag(1, 1, -1, -1) turns
+this into D M^T D at the same dphi, D = diag(1, 1, 1, -1); the form here needs no isotropy.)
 A model term that breaks it (the paper's cos(theta_r) body term, its shadowing function) cannot be the
 physics of a passive surface; measured data that break it beyond their noise point to an instrument
 or alignment error. Germer's PTFE set is reciprocal by construction of his measurement (Appl. Opt. 56,
@@ -16,16 +19,17 @@ import numpy as np
 
 from ..physics.geometry import Geometry
 
-D = np.diag([1.0, 1.0, 1.0, -1.0])
+Q = np.diag([1.0, 1.0, -1.0, 1.0])
 
 
 def reciprocal_image(mueller) -> np.ndarray:
-    """D M^T D for (4, 4, ...) Mueller arrays: what the swapped geometry must measure."""
-    return np.einsum("ij,jk...,kl->il...", D, np.swapaxes(mueller, 0, 1), D)
+    """Q M^T Q for (4, 4, ...) Mueller arrays: what the swapped geometry must measure."""
+    return np.einsum("ij,jk...,kl->il...", Q, np.swapaxes(mueller, 0, 1), Q)
 
 
 def swapped(geometry: Geometry) -> Geometry:
-    return Geometry(geometry.theta_r, geometry.theta_i, geometry.dphi, geometry.wavelength_um)
+    """Source and detector exchanged: theta_i <-> theta_r, dphi -> -dphi."""
+    return Geometry(geometry.theta_r, geometry.theta_i, -geometry.dphi, geometry.wavelength_um)
 
 
 def model_violation(model, params: dict, geometry: Geometry, max_angle_deg: float = 89.0) -> dict:
@@ -45,23 +49,25 @@ def _compare(forward, backward) -> dict:
     ok = (f0 > 0) & (b0 > 0)
     brdf = np.abs(b0[ok] / f0[ok] - 1.0)
     image = reciprocal_image(forward[..., ok] / f0[ok])
-    elements = np.max(np.abs(backward[..., ok] / b0[ok] - image), axis=(0, 1))
-    return {"brdf_relative_median": float(np.median(brdf)), "brdf_relative_p95": float(np.percentile(brdf, 95)),
+    diff = backward[..., ok] / b0[ok] - image
+    elements = np.max(np.abs(diff), axis=(0, 1))
+    return {"element_rms": float(np.sqrt(np.sum(diff**2) / (15 * max(int(ok.sum()), 1)))),  # compare with sqrt(2) x noise
+            "brdf_relative_median": float(np.median(brdf)), "brdf_relative_p95": float(np.percentile(brdf, 95)),
             "element_median": float(np.median(elements)), "element_p95": float(np.percentile(elements, 95)),
             "n_geometries": int(ok.sum())}
 
 
 def data_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
     """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
-    (theta_i and theta_r exchanged, same dphi and wavelength). a = b where theta_i = theta_r: reciprocity
-    then constrains the matrix itself (m12 = m21, m14 = -m41, ...)."""
+    (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
+    and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
     wl = np.zeros(len(data)) if data.wavelength_um is None else data.wavelength_um
     key = {}
     for j in range(len(data)):
         key.setdefault(_rounded(data.theta_i[j], data.theta_r[j], data.dphi[j], wl[j], tolerance_deg), []).append(j)
     pairs = []
     for j in range(len(data)):
-        for k in key.get(_rounded(data.theta_r[j], data.theta_i[j], data.dphi[j], wl[j], tolerance_deg), []):
+        for k in key.get(_rounded(data.theta_r[j], data.theta_i[j], -data.dphi[j], wl[j], tolerance_deg), []):
             if j <= k:
                 pairs.append((j, k))
     return np.array(pairs, int).reshape(-1, 2)
@@ -70,7 +76,8 @@ def data_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
 def _rounded(ti, tr, dphi, wl, tol):
     # NIST's file stores normal incidence as 0.001 deg and normal reflection as 0: both are 0 here
     ti, tr = (0.0 if abs(ti) < 0.01 else ti), (0.0 if abs(tr) < 0.01 else tr)
-    return (round(ti / tol), round(tr / tol), round(((dphi + 180.0) % 360.0 - 180.0) / tol), round(wl * 1e4))
+    dphi = (dphi + 180.0) % 360.0 - 180.0
+    return (round(ti / tol), round(tr / tol), round((180.0 if abs(dphi + 180.0) < tol else dphi) / tol), round(wl * 1e4))
 
 
 def data_violation(data, pairs: np.ndarray | None = None) -> dict:

@@ -7,6 +7,7 @@ measurements in :mod:`spacepol.io`, inference in :mod:`spacepol.infer`, reportin
 
 __version__ = "0.1.0"
 
-from ._threads import limit_blas_threads
+from ._runtime import keep_heap, limit_blas_threads
 
 limit_blas_threads()
+keep_heap()

@@ -151,6 +151,11 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     n = last["n"]
     covered = [lab for lab, q in n.items() if q["q05"] <= PTFE_INDEX_BAND[1] and q["q95"] >= PTFE_INDEX_BAND[0]]
     words = ", ".join(f"n@{lab} {q['median']:.3f} [{q['q05']:.3f}, {q['q95']:.3f}]" for lab, q in n.items())
+    below_one = [lab for lab, q in n.items() if q["q95"] < 1.0]
+    if below_one:
+        out.append(f"n < 1 at {', '.join(below_one)} um (90 % interval): impossible for a bulk polymer in the visible "
+                   f"and near infrared; the fitted 'interface' is not PTFE's surface but whatever lets the facet model "
+                   f"mimic the measured polarization.")
     if len(covered) == len(n) and n:
         out.append(f"The final model's n posteriors ({words}) overlap PTFE's known index band {PTFE_INDEX_BAND}.")
     else:
@@ -219,12 +224,17 @@ def main(argv=None) -> int:
     parser.add_argument("--top", type=int, default=1, help="candidates confirmed by emcee per round")
     parser.add_argument("--model", default="paper", help="where the loop starts")
     parser.add_argument("--joint", default=None, metavar="all|LIST", help="refit the first and last models jointly here")
+    parser.add_argument("--render-only", action="store_true", help="rewrite report.md and figures from OUT/study.json")
     parser.add_argument("--in-plane", action="store_true", help="the plane of incidence only (a quick look, not the study)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="reports/ptfe")
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.render_only:
+        saved = json.loads((out / "study.json").read_text())
+        write_report(out, saved["meta"], saved["rounds"], saved["data_reciprocity"], saved["complete"], saved.get("joint", ()))
+        return 0
     start = time.perf_counter()
     data = load(args.wavelength_um, args.in_plane)
     current = model_for(data, args.model)

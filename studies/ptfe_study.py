@@ -174,12 +174,13 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     out.append(f"Reciprocity of the final model at its posterior median: BRDF changes by a median "
                f"{100 * rec['brdf_relative_median']:.1f} % (95th percentile {100 * rec['brdf_relative_p95']:.1f} %) when "
                f"source and detector swap; normalised elements by up to {rec['element_p95']:.3f} (95th percentile). "
-               f"The measurement's own reciprocal pairs (all wavelengths): {data_recip.get('n_pairs', 0)} pairs, BRDF differs "
-               f"by a median {100 * data_recip.get('brdf_relative_median', float('nan')):.1f} %, normalised elements by "
-               f"{data_recip.get('element_rms', float('nan')):.3f} RMS (sqrt(2) x the inferred element noise, "
-               f"{np.sqrt(2) * rungs[-1]['inferred_noise'].get('sigma_m_lin', float('nan')):.3f} for the linear block, "
-               f"is what noise alone gives): the data are reciprocal within their noise, so a non-reciprocal model "
-               f"term cannot be what the sample does.")
+               f"The measurement's own reciprocal pairs (all wavelengths, {data_recip.get('n_pairs', 0)} pairs): BRDF "
+               f"differs by a median {100 * data_recip.get('brdf_relative_median', float('nan')):.1f} %, normalised "
+               f"elements by {data_recip.get('element_rms', float('nan')):.3f} RMS, i.e. a measurement noise of about "
+               f"{data_recip.get('element_rms', float('nan')) / np.sqrt(2):.3f} per element: the data are reciprocal "
+               f"within it (a non-reciprocal model term cannot be what the sample does), and an inferred element noise "
+               f"above it (" + ", ".join(f"{k} {v:.3f}" for k, v in rungs[-1]["inferred_noise"].items() if k.startswith("sigma_m"))
+               + ") is model misfit, not the polarimeter.")
     return out
 
 

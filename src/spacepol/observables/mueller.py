@@ -31,8 +31,8 @@ def index(element: str) -> tuple[int, int]:
 
 def normalised(mueller) -> dict[str, np.ndarray]:
     """{m_ij: M_ij / M_11} from a (4, 4, ...) Mueller array (0 where M_11 = 0)."""
-    m11 = np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)
-    return {e: mueller[index(e)] / m11 for e in ELEMENTS}
+    inverse = 1.0 / np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)
+    return {e: mueller[index(e)] * inverse for e in ELEMENTS}
 
 
 class Mueller(Observable):

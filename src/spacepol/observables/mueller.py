@@ -31,8 +31,8 @@ def index(element: str) -> tuple[int, int]:
 
 def normalised(mueller) -> dict[str, np.ndarray]:
     """{m_ij: M_ij / M_11} from a (4, 4, ...) Mueller array (0 where M_11 = 0)."""
-    inverse = 1.0 / np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)
-    return {e: mueller[index(e)] * inverse for e in ELEMENTS}
+    m11 = np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)  # divide, not multiply by 1/M11: M11 may be subnormal
+    return {e: mueller[index(e)] / m11 for e in ELEMENTS}
 
 
 class Mueller(Observable):

@@ -83,7 +83,7 @@ def changes(model: Model, data, names=None) -> list[Change]:
     the model may be removed or replaced by another pure addition: an addition taken early, while another
     part of the model was still wrong, can then give way to the one the data prefer once the rest is right."""
     present = [e.name for e in model.effects]
-    additions = [e.name for e in model.effects if not e.slot]
+    additions = [e.name for e in model.effects if not e.slot and not e.essential]
     out: list[Change] = []
     for name in names or registry.names():
         if name in present:
@@ -99,7 +99,7 @@ def changes(model: Model, data, names=None) -> list[Change]:
             except SpacepolError:
                 continue  # does not compose (e.g. smith beside shadowing, ggx without specular)
     for e in model.effects:
-        if (e.removable or not e.slot) and (names is None or e.name in names):
+        if (e.removable or not (e.slot or e.essential)) and (names is None or e.name in names):
             try:
                 out.append(Change("remove", e.name, apply(model, f"remove {e.name}")))
             except SpacepolError:

@@ -13,6 +13,7 @@ from .shadowing import PAPER_CONSTANTS, paper_shadowing
 
 class Specular(Effect):
     name = "specular"
+    essential = True  # every other lobe and modifier is defined relative to it
     parameters = (
         Parameter("n", "", Uniform(0.1, 5.0), 1.5, "real part of the complex refractive index N = n + ik", physical=(1e-6, np.inf)),
         Parameter("k", "", Uniform(0.0, 20.0), 0.0, "extinction coefficient, imaginary part of N", physical=(0.0, np.inf)),

@@ -95,6 +95,8 @@ class Effect:
     * ``slot``: the role it plays ("shadowing", "body", "facets"), or None for a pure addition;
       effects of one slot can replace each other ("replace shadowing by smith");
     * ``removable``: "remove E" is a sensible change (a shadowing term, a diffuse lobe);
+    * ``essential``: the lobe the model is built on (``specular``): never removed or swapped for an
+      addition, though it has no slot;
     * ``twins``: {other effect: the measurement that separates them} for effects that predict the
       same thing on some data (both are then always refitted, and a tie is reported with it);
     * ``neutral``: parameter values at which the effect changes nothing (where the optimiser starts
@@ -117,6 +119,7 @@ class Effect:
     description: str = ""
     slot: str | None = None
     removable: bool = False
+    essential: bool = False
     twins: dict = {}
     neutral: dict = {}
     splits: dict = {}

@@ -197,7 +197,8 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
              f"{meta['rows']} geometries x ({', '.join(meta['observables'])}) = {meta['numbers']} measured numbers at "
              f"{meta['wavelengths']} um. {SOURCE}.", "",
              "## Findings", ""] + [f"- {f}" for f in findings(rungs, data_recip)] + (
-             [f"- Jointly over {meta['joint_wavelengths']} um ({joint[-1]['model']}): " + findings(joint, data_recip)[0]]
+             [f"- Jointly over {meta['joint_wavelengths']} um ({joint[-1]['model']}): "
+              + " ".join(f for f in findings(joint, data_recip) if f.startswith(("n < 1", "The final model's n")))]
              if joint else []) + [
              "", "## Rounds", "",
              "| round | change | delta ELPD | ELPD-LOO | inferred noise | n(lambda) median | at bound | reciprocity (BRDF median, elements p95) |",

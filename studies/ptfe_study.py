@@ -140,7 +140,7 @@ def structure_figure(rungs: list[dict]):
     for (i, j), v in np.ndenumerate(z):
         if np.isfinite(v):
             ax.text(j, i, f"{v:.0f}", ha="center", va="center", fontsize=7)
-    fig.colorbar(im, ax=ax, label="runs-test z (|z| > 2.6: smooth misfit, p < 0.01)")
+    fig.colorbar(im, ax=ax, label="runs-test z (< -2.6: smooth misfit; > 2.6: alternating; p < 0.01)")
     ax.set_title("Residual structure per element and round (noise: |z| < 2.6)")
     return fig
 
@@ -161,11 +161,17 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     else:
         out.append(f"The final model's n posteriors ({words}) do not reach PTFE's known index band {PTFE_INDEX_BAND} "
                    f"at {len(n) - len(covered)} of {len(n)} wavelengths: n is absorbing a misfit, not measuring the surface.")
-    structured = [ch for ch, z in last["runs_z"].items() if abs(z) > 2.6]
-    if structured:
-        out.append(f"Residuals remain smooth (runs-test |z| > 2.6) in {len(structured)} of {len(last['runs_z'])} "
-                   f"channels: {', '.join(structured)}: the final model still misses physics there.")
-    else:
+    smooth = [ch for ch, z in last["runs_z"].items() if z < -2.6]
+    alternating = [ch for ch, z in last["runs_z"].items() if z > 2.6]
+    if smooth:
+        out.append(f"Residuals remain smooth along the sweeps (runs-test z < -2.6: fewer sign changes than noise) in "
+                   f"{len(smooth)} of {len(last['runs_z'])} channels: {', '.join(smooth)}: the final model still misses "
+                   f"physics there.")
+    if alternating:
+        out.append(f"Residuals change sign more often than noise (z > 2.6) in {', '.join(alternating)}: a misfit of "
+                   f"alternating sign between neighbouring rows, also structure (m13, m14, m23, m24, m31, m32, m41, m42 are "
+                   f"odd in dphi: a misfit that flips sign with dphi alternates wherever rows of opposite dphi meet).")
+    if not smooth and not alternating:
         out.append("No channel's residuals show structure along the sweeps: the final model leaves noise.")
     if last["at_bound"]:
         out.append("Parameters at a prior bound (the fit is unphysical there; their intervals are not measurements): "

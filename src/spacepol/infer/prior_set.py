@@ -15,6 +15,10 @@ Defaults come from each effect's ``Parameter``; a TOML file overrides them::
     lower = 0.0
     upper = 0.1
 
+    ["n@0.633"]              # a refractiveindex.info table (data/nk/ or a path): normal at its value
+    nk_table = "main_Al_nk_Rakic.yml"
+    relative_sigma = 0.05    # (plain n, k need wavelength_um = ...)
+
 The parameter vector ``theta`` (shape (W, D)) lists the free parameters in model order; the
 unit cube u in [0, 1]^D maps to theta through each prior's inverse CDF (``rescale``), so the
 GA, nlopt and differential evolution search the very space the sampler sees.
@@ -34,7 +38,54 @@ from .priors import Fixed, LogUniform, Prior, TruncatedNormal, Uniform
 _KEYS = {"distribution", "lower", "upper", "mu", "sigma", "fixed"}
 
 
+_NK_KEYS = {"nk_table", "wavelength_um", "relative_sigma", "sigma", "lower", "upper"}
+
+
+def prior_from_nk_table(name: str, table: dict, where: str) -> Prior:
+    """A truncated normal on n or k centred on a refractiveindex.info table (``data/nk/`` or a path) at the
+    parameter's wavelength (``n@0.633``; or ``wavelength_um`` for a plain ``n``); width ``sigma``, or
+    ``relative_sigma`` (default 5 %: tables of one material from different sources differ by that much)
+    of the value, at least 1e-3; bounds 6 widths either side unless given, never below 0."""
+    from ..errors import InputFileError, SpacepolError
+    from ..io.nk import RefractiveIndex
+    from ..paths import bundled
+
+    unknown = set(table) - _NK_KEYS
+    if unknown:
+        raise ParameterError(f"{where}: [{name}] has unknown key(s) {', '.join(sorted(unknown))} with nk_table "
+                             f"(allowed: {', '.join(sorted(_NK_KEYS))})")
+    bare, _, label = name.partition("@")
+    if bare not in ("n", "k", "n_film"):
+        raise ParameterError(f"{where}: [{name}] nk_table gives priors of n, k or n_film, not {name}")
+    if "wavelength_um" in table:
+        wavelength = _float(table["wavelength_um"], name, "wavelength_um", where)
+    elif label:
+        wavelength = float(label)
+    else:
+        raise ParameterError(f"{where}: [{name}] nk_table needs wavelength_um (or name the parameter {name}@LAMBDA)")
+    source = Path(str(table["nk_table"]))
+    try:
+        if not source.is_file():  # beside the prior file, else one of the bundled tables
+            source = Path(where).parent / source if (Path(where).parent / source).is_file() else bundled("nk", str(source))
+        index = RefractiveIndex(source)(wavelength)
+    except InputFileError as exc:
+        raise ParameterError(f"{where}: [{name}] {exc}") from None
+    except SpacepolError as exc:  # bundled(): no such file
+        raise ParameterError(f"{where}: [{name}] nk_table {table['nk_table']}: {exc}") from None
+    mu = float(index.imag if bare == "k" else index.real)
+    relative = _float(table.get("relative_sigma", 0.05), name, "relative_sigma", where)
+    sigma = _float(table["sigma"], name, "sigma", where) if "sigma" in table else max(relative * mu, 1e-3)
+    lower = _float(table["lower"], name, "lower", where) if "lower" in table else max(0.0, mu - 6 * sigma)
+    upper = _float(table["upper"], name, "upper", where) if "upper" in table else mu + 6 * sigma
+    try:
+        return TruncatedNormal(mu, sigma, lower, upper)
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: [{name}] {exc}") from None
+
+
 def prior_from_table(name: str, table: dict, where: str) -> Prior:
+    if "nk_table" in table:
+        return prior_from_nk_table(name, table, where)
     unknown = set(table) - _KEYS
     if unknown:
         raise ParameterError(f"{where}: [{name}] has unknown key(s) {', '.join(sorted(unknown))} (allowed: {', '.join(sorted(_KEYS))})")

@@ -34,10 +34,14 @@ class ResidualReport:
         out = []
         for o in self.observables:
             r = self.runs[o]
-            if r["p"] < alpha:
+            if r["p"] < alpha and r["z"] < 0:
                 out.append(f"{o}: residuals change sign {r['runs']} times along the sweeps where {r['expected']:.0f} "
                            f"are expected (z = {r['z']:.1f}, p = {r['p']:.1g}): the misfit is smooth, a missing "
                            f"physical effect rather than noise.")
+            elif r["p"] < alpha:  # too many sign changes: neighbours along a sweep disagree in sign
+                out.append(f"{o}: residuals change sign {r['runs']} times along the sweeps where {r['expected']:.0f} "
+                           f"are expected (z = {r['z']:+.1f}, p = {r['p']:.1g}): the misfit alternates between "
+                           f"neighbouring rows (off the plane, rows of opposite dphi meet along a sweep), not noise.")
             for var, t in self.trends[o].items():
                 if t["p"] < alpha:
                     out.append(f"{o}: residuals trend with {var} (Spearman rho = {t['rho']:+.2f}, p = {t['p']:.1g}).")

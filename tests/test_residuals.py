@@ -49,3 +49,14 @@ def test_a_hidden_effect_leaves_structure_and_a_good_model_does_not(hidden, expe
     structured = report.runs["dop"]["p"] < 0.01 or any(t["p"] < 0.01 for t in report.trends["dop"].values())
     assert structured == expect_structure, report.findings()
     assert len(sweeps(data)) == 3
+
+
+def test_too_many_sign_changes_are_called_alternating_not_smooth():
+    from spacepol.criticism.residuals import ResidualReport
+
+    def report(z):
+        runs = {"m13": {"runs": 10, "expected": 20.0, "z": z, "p": 1e-6}}
+        return ResidualReport(["m13"], {}, {}, runs, {}, {"m13": {}}).findings()[0]
+
+    assert "smooth" in report(-5.0) and "alternates" not in report(-5.0)
+    assert "alternates" in report(+5.0) and "smooth" not in report(+5.0)

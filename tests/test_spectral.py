@@ -21,13 +21,18 @@ def _cauchy_set(seed=1):
     ti, tr = np.tile(ti0.ravel(), len(LAMBDAS)), np.tile(tr0.ravel(), len(LAMBDAS))
     wl = np.repeat(LAMBDAS, ti0.size)
     g = Geometry(ti, tr, np.full(ti.size, 180.0), wl)
-    pred = SpectralModel(Model.from_string(BASE), LAMBDAS, {"n": "cauchy"}).evaluate(TRUTH, g)
-    rng = np.random.default_rng(seed)
-    d = Dataset(ti, tr, np.full(ti.size, 180.0), wavelength_um=wl)
+    model = SpectralModel(Model.from_string(BASE), LAMBDAS, {"n": "cauchy"})
+    return _measured(model, TRUTH, g, np.random.default_rng(seed), "synthetic Cauchy set")
+
+
+def _measured(model, values, g, rng, source):
+    """DOP (0.004 absolute) and BRDF (2 %) of ``model`` at ``g`` with Gaussian noise of known size."""
+    pred = model.evaluate(values, g)
+    d = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=g.wavelength_um)
     d.dop, d.dop_err = np.clip(pred.dop + 0.004 * rng.standard_normal(g.size), 0, 1), np.full(g.size, 0.004)
     d.brdf = pred.brdf * (1 + 0.02 * rng.standard_normal(g.size))
     d.brdf_err = 0.02 * pred.brdf
-    d.source = "synthetic Cauchy set"
+    d.source = source
     return d
 
 
@@ -88,13 +93,7 @@ def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per
     rng = np.random.default_rng(4)
 
     def render(model, values):
-        pred = model.evaluate(values, g)
-        d = Dataset(ti, tr, np.full(ti.size, 180.0), wavelength_um=wl)
-        d.dop, d.dop_err = np.clip(pred.dop + 0.004 * rng.standard_normal(g.size), 0, 1), np.full(g.size, 0.004)
-        d.brdf = pred.brdf * (1 + 0.02 * rng.standard_normal(g.size))
-        d.brdf_err = 0.02 * pred.brdf
-        d.source = "synthetic two-wavelength set"
-        return d
+        return _measured(model, values, g, rng, "synthetic two-wavelength set")
 
     hidden = diagnose(render(changed, truth), base, np.random.default_rng(0), candidates=["lambertian", "oxide_layer"], top=1)
     assert hidden["verdict"] == "lambertian", hidden["ranking"][:2]

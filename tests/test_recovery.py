@@ -102,6 +102,30 @@ def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path
     assert empty.returncode == 2 and "empty file" in empty.stderr
 
 
+def test_a_chain_whose_random_state_a_kill_broke_continues(data, tmp_path):
+    """emcee rewrites its random state (a string attribute in HDF5's global heap) at every step; a kill there
+    leaves it unreadable ("Expected global heap object size does not match") with every step intact. The
+    same command continues from the stored steps with a state drawn from the run's generator; the steps
+    already stored are kept exactly."""
+    import h5py
+    import numpy as np
+
+    out = tmp_path / "run"
+    first = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    assert first.returncode == 0, first.stderr
+    chain = out / "chain.h5"
+    with h5py.File(chain, "a") as f:  # what a reader sees after the kill: no readable random state
+        for key in [k for k in f["mcmc"].attrs if k.startswith("random_state")]:
+            del f["mcmc"].attrs[key]
+        before = f["mcmc"]["chain"][:500].copy()
+    more = cli("run", data, *RUN, "--steps", "1000", "--out", out)
+    assert more.returncode == 0, more.stderr
+    assert "resuming the chain" in more.stderr and "Traceback" not in more.stderr
+    with h5py.File(chain, "r") as f:
+        assert f["mcmc"].attrs["iteration"] == 1000
+        np.testing.assert_array_equal(f["mcmc"]["chain"][:500], before)
+
+
 def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
     out = tmp_path / "run"
     slow = ("--model", "paper", "--observables", "dop", "--seed", "2")  # the k_s/rho_d ridge: thousands of steps

@@ -44,8 +44,6 @@ def chain_iterations(path, group: str = "mcmc") -> int:
             if iteration > 0:  # read the last step: it is the one a kill during a write leaves broken
                 chain[iteration - 1]
                 log_prob[iteration - 1]
-                if "random_state" not in g.attrs and not any(k.startswith("random_state") for k in g.attrs):
-                    raise _damaged(path, "no random state stored")
             return iteration
     except ChainFileError:
         raise
@@ -54,6 +52,53 @@ def chain_iterations(path, group: str = "mcmc") -> int:
                              f"wait for it or use another --out") from None
     except (OSError, KeyError, ValueError, RuntimeError) as exc:
         raise _damaged(path, f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'unreadable'}") from None
+
+
+def random_state_readable(path, group: str = "mcmc") -> bool:
+    """Whether the sampler's random state stored beside the chain can be read back. emcee rewrites it (an
+    attribute holding a string, in HDF5's global heap) at every step, so a kill can break it while every
+    stored step is intact."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            attrs = f[group].attrs
+            keys = [k for k in attrs if k.startswith("random_state")]
+            for k in keys:
+                attrs[k]
+            return bool(keys)
+    except (OSError, KeyError, ValueError, RuntimeError):
+        return False
+
+
+def replace_random_state(path, state, group: str = "mcmc") -> None:
+    """Rewrite ``path`` with every dataset and readable attribute, and ``state`` (numpy's RandomState
+    tuple) as the random state, as emcee stores it; atomic (a copy renamed into place). The chain is kept;
+    only the stream of random numbers after it differs from an uninterrupted run's."""
+    import h5py
+
+    from ..io.atomic import atomic_path
+
+    path = Path(path)
+    with atomic_path(path) as tmp, h5py.File(path, "r") as src, h5py.File(tmp, "w") as dst:
+        _copy_attrs(src.attrs, dst.attrs)
+        for name in src:
+            out = dst.create_group(name)
+            _copy_attrs(src[name].attrs, out.attrs)
+            for key in src[name]:
+                src[name].copy(src[name][key], out, name=key)
+        for i, value in enumerate(state):
+            dst[group].attrs[f"random_state_{i}"] = value
+
+
+def _copy_attrs(source, target) -> None:
+    for key in list(source.keys()):
+        if key.startswith("random_state"):
+            continue
+        try:
+            target[key] = source[key]
+        except (OSError, KeyError, ValueError, RuntimeError):
+            continue  # unreadable after the kill: emcee rewrites what it needs at the next step
 
 
 def set_aside(path) -> Path | None:

@@ -90,7 +90,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
                  tau_multiple: float = 50.0, check_every: int = 500, min_steps: int = 1000,
                  backend_path=None, progress: bool = True, model_name: str = "", seed: int | None = None,
                  initial=None, rhat_target: float = 1.01, ess_target: float = 400.0) -> Result:
-    from ..chain_file import chain_iterations
+    from ..chain_file import chain_iterations, random_state_readable, replace_random_state
 
     start = time.perf_counter()
     ndim = posterior.ndim
@@ -99,6 +99,10 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     resumed = False
     if backend_path is not None:
         stored = chain_iterations(backend_path)  # ChainFileError (one line, the remedy) if damaged
+        if stored > 0 and not random_state_readable(backend_path):
+            # killed while emcee rewrote its random state: the steps are intact, so continue from them with a
+            # state drawn from this run's generator (reproducible from --seed and the step count)
+            replace_random_state(backend_path, np.random.RandomState(int(rng.integers(2**32)) ^ stored).get_state())
         backend = emcee.backends.HDFBackend(str(backend_path), name="mcmc")
         if stored > 0:
             if tuple(backend.shape) != (walkers, ndim):

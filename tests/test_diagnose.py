@@ -122,8 +122,8 @@ def test_prior_overrides_reach_the_models_that_have_the_parameter():
 
 @pytest.mark.slow
 def test_ptfe_diagnosis_states_which_effects_improve_elpd(tmp_path):
-    """On the bundled PTFE measurement (0.633 um, in-plane, DOP + BRDF) diagnose runs with the whole library
-    and its report says which effects improve ELPD-LOO by more than 2 SE and which do not."""
+    """On the bundled PTFE measurement (0.633 um, in-plane; by default its 15 Mueller elements and the BRDF)
+    diagnose runs with the whole library and its report says which effects improve ELPD-LOO by more than 2 SE and which do not."""
     from spacepol.paths import bundled
 
     out, js = tmp_path / "ptfe", tmp_path / "ptfe.json"

@@ -47,8 +47,7 @@ def per_call(posterior: Posterior, repeats: int = 15) -> tuple[float, float]:
     rng = np.random.default_rng(1)
     theta = posterior.priors.sample(rng, 20)
     lik = posterior.likelihood
-    names = {p.name for p in lik.model.parameters}
-    params = {k: v for k, v in posterior.priors.to_params(theta).items() if k in names}
+    params = posterior.model_params(theta)
     forward, total = [], []
     for _ in range(repeats):
         t0 = time.perf_counter()

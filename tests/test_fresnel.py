@@ -74,7 +74,10 @@ def test_rotated_mueller_is_the_product_of_rotations_and_fresnel_matrix():
         return np.array([[1, 0, 0, 0], [0, c, s, 0], [0, -s, c, 0], [0, 0, 0, 1]], dtype=float)
 
     got = fresnel.rotated_mueller(r_s, r_p, np.cos(2 * eta_i), np.sin(2 * eta_i), np.cos(2 * eta_r), np.sin(2 * eta_r), scale)
-    m_f = fresnel.mueller_from_amplitudes(r_s, r_p)
+    cross = r_s * np.conj(r_p)
+    a, b = 0.5 * (abs(r_s) ** 2 + abs(r_p) ** 2), 0.5 * (abs(r_s) ** 2 - abs(r_p) ** 2)
+    c, d, zero = cross.real, cross.imag, np.zeros(50)
+    m_f = np.array([[a, b, zero, zero], [b, a, zero, zero], [zero, zero, c, d], [zero, zero, -d, c]])  # eq 21
     for j in range(50):
         want = rotator(eta_r[j]) @ m_f[:, :, j] @ rotator(eta_i[j]) * scale[j]
         np.testing.assert_allclose(got[:, :, j], want, rtol=0, atol=1e-14)

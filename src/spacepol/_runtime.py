@@ -36,6 +36,7 @@ def keep_heap() -> None:
     except (OSError, AttributeError):  # not glibc (musl, ...): nothing to tune
         return
 
+
 _VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
 
 

@@ -58,12 +58,10 @@ def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> di
     lik = posterior.likelihood
     mu, scale = median_fit(posterior, result.flat_samples())
     chi2 = sum(float(np.sum(lik.standardise(o, mu[o], scale[o]) ** 2)) for o in lik.observables)
-    if "dop" in lik.observables:
-        rmse = float(np.sqrt(np.mean((lik.data.dop - mu["dop"]) ** 2)))
-    elif lik.data.dop is not None:
-        rmse = float(np.sqrt(np.mean((lik.data.dop - model_dop(posterior, result.flat_samples())) ** 2)))
-    else:
-        rmse = None
+    rmse = None
+    if lik.data.dop is not None:
+        predicted = mu["dop"] if "dop" in lik.observables else model_dop(posterior, result.flat_samples())
+        rmse = float(np.sqrt(np.mean((lik.data.dop - predicted) ** 2)))
     dof = max(lik.n_obs - posterior.ndim, 1)
     return {"rmse_dop": rmse, "chi2_red": chi2 / dof, "elpd_loo": loo_result["elpd_loo"],
             "elpd_loo_se": loo_result["elpd_loo_se"]}

@@ -24,12 +24,10 @@ def _batched(fn, flat, batch: int):
 
 def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
     """Noise-free model predictions for each parameter set: {observable: (S, N)}."""
-    lik, priors = posterior.likelihood, posterior.priors
-    names = {p.name for p in lik.model.parameters}
+    lik = posterior.likelihood
 
     def one(block):
-        params = {k: v for k, v in priors.to_params(block).items() if k in names}
-        pred = lik.predict(params)
+        pred = lik.predict(posterior.model_params(block))
         return np.stack([pred[o] for o in lik.observables], axis=0).transpose(1, 0, 2)
 
     stacked = _batched(one, flat_theta, lik.batch_sets)  # (S, n_observables, N)
@@ -39,10 +37,8 @@ def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
 def model_dop(posterior: Posterior, flat_theta, draws: int = 200) -> np.ndarray:
     """Posterior-median model DOP at the data's geometries, also where DOP is not fitted (a Mueller fit
     predicts it from its first column): (N,). Up to ``draws`` evenly thinned samples."""
-    lik, priors = posterior.likelihood, posterior.priors
-    names = {p.name for p in lik.model.parameters}
-    thinned = flat_theta[:: max(1, len(flat_theta) // draws)]
-    params = {k: v for k, v in priors.to_params(thinned).items() if k in names}
+    lik = posterior.likelihood
+    params = posterior.model_params(flat_theta[:: max(1, len(flat_theta) // draws)])
     return np.median(np.atleast_2d(lik.model.evaluate(params, lik.geometry, check=False).dop), axis=0)
 
 
@@ -81,7 +77,7 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
     n = len(lik.data)
     flat = samples.transpose(1, 0, 2).reshape(-1, ndim)  # chain-major
     step = pointwise_thinning(draws, chains, lik.n_obs)
-    kept = draws if step == 1 else len(range(0, draws, step))
+    kept = len(range(0, draws, step))
     flat_kept = samples[::step].transpose(1, 0, 2).reshape(-1, ndim)
     loglik = _batched(posterior.log_prob_pointwise, flat_kept, lik.batch_sets)  # (S', M)
     means = predictive_means(posterior, flat_kept)

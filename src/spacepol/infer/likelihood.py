@@ -20,15 +20,17 @@ from ..io.measurements import Dataset
 from ..physics.model import Model
 from ..physics.parameter import Parameter
 
-def select_observables(data: Dataset, names=None) -> list:
-    """The Observable objects to fit: those named (aliases such as q, u allowed), or by default every
-    observable in the data except those a fuller one contains (``observables.default_for``: the Mueller
-    matrix holds q, u, DOP and AoP). Unknown, absent or repeated names are one-line errors."""
+def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
+    """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
+    numbers}``: those named (aliases such as q, u allowed; nothing left out), or by default every observable
+    in the data except those a fuller one contains (``observables.default_for``: the Mueller matrix holds
+    q, u, DOP and AoP). Unknown, absent or repeated names are one-line errors."""
     available = [o.name for o in obs.OBSERVABLES.values() if o.present(data)]
     if not names:
         if not available:
             raise ParameterError(f"{data.source}: no observable to fit (DOP, BRDF, Stokes, AoP or Mueller columns)")
-        return [obs.get(n) for n in obs.default_for(available)[0]]
+        chosen, left_out = obs.default_for(available)
+        return [obs.get(n) for n in chosen], left_out
     names = list(names)
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
@@ -40,16 +42,14 @@ def select_observables(data: Dataset, names=None) -> list:
             raise ParameterError(f"{data.source}: observable '{name}' is not in the data (it has {', '.join(available) or 'none'})")
         if o not in chosen:
             chosen.append(o)
-    return chosen
+    return chosen, {}
 
 
 class Likelihood:
     def __init__(self, data: Dataset, model: Model, observables=None, robust: bool = False, nu: float = 4.0):
         self.data, self.model = data, model
-        self.objects = select_observables(data, observables)
-        # observables in the data not fitted because a fitted one holds their numbers: {name: holder}
-        self.left_out = {} if observables else obs.default_for([o.name for o in obs.OBSERVABLES.values()
-                                                                 if o.present(data)])[1]
+        # left_out: observables in the data not fitted because a fitted one holds their numbers
+        self.objects, self.left_out = select_observables(data, observables)
         self.observable_names = [o.name for o in self.objects]
         self.needs_mueller = any(o.needs_mueller for o in self.objects)
         self._owner, self._y, self._errors, self._profile = {}, {}, {}, {}

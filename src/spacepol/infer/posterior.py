@@ -35,9 +35,7 @@ class Posterior:
         fixed-seed generator, so the user's random stream is untouched."""
         rng = np.random.default_rng(20261122)
         theta = np.vstack([self.priors.rescale(np.full((1, self.ndim), 0.5)), self.priors.sample(rng, draws)])
-        names = {p.name for p in self.likelihood.model.parameters}
-        params = {k: v for k, v in self.priors.to_params(theta).items() if k in names}
-        self.likelihood.model.check_plugins(params, self.likelihood.data.geometry)
+        self.likelihood.model.check_plugins(self.model_params(theta), self.likelihood.data.geometry)
         lp = self.priors.ln_prob(theta)
         if not np.any(np.isfinite(lp)):
             raise ParameterError(f"{where}: the prior density is zero at every one of {len(theta)} draws from it")
@@ -52,6 +50,11 @@ class Posterior:
     @property
     def ndim(self) -> int:
         return self.priors.ndim
+
+    def model_params(self, theta) -> dict:
+        """{model parameter: values} for the rows of theta (W, D); the likelihood's noise levels left out."""
+        names = {p.name for p in self.likelihood.model.parameters}
+        return {k: v for k, v in self.priors.to_params(np.atleast_2d(theta)).items() if k in names}
 
     def log_prob_pointwise(self, theta) -> np.ndarray:
         theta = np.atleast_2d(theta)

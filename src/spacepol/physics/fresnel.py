@@ -80,25 +80,10 @@ def power_paper_eq15(n, k, cos_theta, sin2_theta):
     return r_s, r_p
 
 
-def mueller_from_amplitudes(r_s, r_p):
-    """Non-depolarizing Mueller matrix of reflection, shape (4, 4, ...), eq 21's M_F."""
-    rs2, rp2 = np.abs(r_s) ** 2, np.abs(r_p) ** 2
-    cross = r_s * np.conj(r_p)
-    zero = np.zeros_like(rs2)
-    a, b, c, d = 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), cross.real, cross.imag
-    return np.array(
-        [
-            [a, b, zero, zero],
-            [b, a, zero, zero],
-            [zero, zero, c, d],
-            [zero, zero, -d, c],
-        ]
-    )
-
-
-
 def rotated_mueller(r_s, r_p, cos_2in, sin_2in, cos_2out, sin_2out, scale=1.0):
-    """``scale`` x L(eta_out) M_F L(eta_in): eq 21's M_F between the Stokes-basis rotations
+    """``scale`` x L(eta_out) M_F L(eta_in): eq 21's non-depolarizing Mueller matrix of reflection
+    M_F = [[a, b, 0, 0], [b, a, 0, 0], [0, 0, c, d], [0, 0, -d, c]] (a, b = (|r_s|^2 +- |r_p|^2) / 2,
+    c + id = r_s r_p*) between the Stokes-basis rotations
     L(eta) = [[1, 0, 0, 0], [0, c, s, 0], [0, -s, c, 0], [0, 0, 0, 1]] (c, s = cos 2 eta, sin 2 eta).
 
     Written out element by element: M_F has only eight non-zero entries and L rotates one 2 x 2 block,
@@ -117,6 +102,7 @@ def rotated_mueller(r_s, r_p, cos_2in, sin_2in, cos_2out, sin_2out, scale=1.0):
     out[1, 3], out[2, 3] = so * d, co * d
     out[3, 1], out[3, 2], out[3, 3] = d * si, -d * ci, c
     return out
+
 
 # The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on
 # SCATMECH's grid (0 to 90 deg in 0.2 deg steps, Diffuse_Subsurface_BRDF_Model), so the two agree to

@@ -114,15 +114,14 @@ class SpectralModel:
             groups = []
             for lam in self.wavelengths:
                 idx = np.flatnonzero(np.abs(geometry.wavelength_um - lam) < 1e-6)
-                if idx.size and idx[-1] - idx[0] + 1 == idx.size:
-                    idx = slice(int(idx[0]), int(idx[-1]) + 1)  # a block of rows: copied, not gathered
-                if np.size(geometry.wavelength_um[idx]):
-                    sub = Geometry(geometry.theta_i[..., idx], geometry.theta_r[..., idx], geometry.dphi[..., idx],
-                                   geometry.wavelength_um[idx])
-                    groups.append((idx, sub))
-                else:
+                if not idx.size:
                     groups.append((idx, None))
-            covered = sum(0 if sub is None else sub.size for _, sub in groups)
+                    continue
+                if idx[-1] - idx[0] + 1 == idx.size:
+                    idx = slice(int(idx[0]), int(idx[-1]) + 1)  # a block of rows: copied, not gathered
+                groups.append((idx, Geometry(geometry.theta_i[..., idx], geometry.theta_r[..., idx],
+                                             geometry.dphi[..., idx], geometry.wavelength_um[idx])))
+            covered = sum(sub.size for _, sub in groups if sub is not None)
             if covered != geometry.size:
                 raise ParameterError(f"{geometry.size - covered} measurements lie at none of the wavelengths "
                                      f"{', '.join(self.labels)} um")

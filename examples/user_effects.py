@@ -6,8 +6,12 @@ Use them from the command line with ``--effect examples/user_effects.py:Oppositi
 
     [project.entry-points."spacepol.effects"]
     opposition_surge = "my_package.effects:OppositionSurge"
+
+Hooks are JAX code (they are compiled and evaluated for many parameter sets at once): compute with
+``jax.numpy`` and return new arrays (``lobe.at[1:].multiply(f)``, not ``lobe[1:] *= f``).
 """
 
+import jax.numpy as jnp
 import numpy as np
 
 from spacepol.infer.priors import Uniform
@@ -30,9 +34,9 @@ class OppositionSurge(Effect):
 
     def lobe(self, ctx):
         geo = ctx.geometry
-        cos_phase = np.clip(np.sum(geo.k_i * geo.k_r, axis=-1), -1.0, 1.0)
-        phase_deg = np.degrees(np.arccos(cos_phase))
-        return ctx.depolarized(ctx["b0"] * np.exp(-phase_deg / ctx["h_deg"]))
+        cos_phase = jnp.clip(jnp.sum(geo.k_i * geo.k_r, axis=-1), -1.0, 1.0)
+        phase_deg = jnp.degrees(jnp.arccos(cos_phase))
+        return ctx.depolarized(ctx["b0"] * jnp.exp(-phase_deg / ctx["h_deg"]))
 
 
 @effect(
@@ -42,4 +46,4 @@ class OppositionSurge(Effect):
     description="A polarimeter whose DOP calibration is off by a constant gain (the DOP is clipped to 1).",
 )
 def DopScaleError(ctx, dop, gain):
-    return np.minimum(gain * dop, 1.0)
+    return jnp.minimum(gain * dop, 1.0)

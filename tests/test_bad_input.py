@@ -165,6 +165,20 @@ PLUGINS = {
         def lobe(self, ctx):
             sys.exit(3)
     """, ["bad_effect", "sys.exit(3)"]),
+    # written for numpy: JAX cannot trace these (the parameter sets are traced values)
+    "numpy": ("""
+        def lobe(self, ctx):
+            return ctx.depolarized(np.exp(-np.asarray(ctx.geometry.cos_tr * ctx["ks"])))
+    """, ["bad_effect", "cannot be compiled by JAX", "jax.numpy"]),
+    "in_place": ("""
+        def modify_stokes(self, ctx, total):
+            total[1:] *= 0.5
+            return total
+    """, ["bad_effect", "in place", ".at[1:]"]),
+    "branch": ("""
+        def lobe(self, ctx):
+            return ctx.depolarized(ctx.geometry.cos_tr) if float(ctx["ks"].max()) > 0.5 else None
+    """, ["bad_effect", "cannot be compiled by JAX"]),
 }
 
 

@@ -11,7 +11,6 @@ from spacepol.physics.effects import registry
 MODELS = [
     "specular+shadowing+body+polarized_diffuse+depolarization+oxide_layer+angle_offset+extinction+dop_bias",
     "specular+smith+ggx+anisotropy+body+polarized_diffuse+lambertian+subsurface",
-    # these two take the compiled Stokes kernel (isotropic facets, bulk Fresnel, fixed geometry)
     "specular+shadowing+body+polarized_diffuse+depolarization+extinction+dop_bias",
     "specular+smith+ggx+body",
 ]
@@ -60,22 +59,6 @@ def test_outputs_are_physical(spec, data):
     stokes_only = model.evaluate(params, geometry).stokes
     via_mueller = model.evaluate(params, geometry, mueller=True).stokes
     assert np.all(np.abs(stokes_only - via_mueller) <= 1e-9 * np.abs(via_mueller) + 1e-10 * via_mueller[0] + 1e-300)
-
-
-@pytest.mark.parametrize("spec", ["paper", "specular+smith+ggx+body+polarized_diffuse", "paper+depolarization"])
-def test_compiled_kernel_equals_numpy_path(spec, monkeypatch):
-    """The fused kernel computes what the numpy code computes (the numpy path is the reference)."""
-    from spacepol.physics.builtin_effects import Specular
-
-    rng = np.random.default_rng(11)
-    model = Model.from_string(spec)
-    params = {p.name: p.prior.sample(rng, 64) for p in model.free_parameters}
-    geometry = Geometry(rng.uniform(0, 89, 50), rng.uniform(0, 89, 50), rng.uniform(-180, 180, 50))
-    fast = model.evaluate(params, geometry)
-    monkeypatch.setattr(Specular, "_fast_path_applies", staticmethod(lambda ctx: False))
-    slow = model.evaluate(params, geometry)
-    np.testing.assert_allclose(fast.stokes, slow.stokes, rtol=1e-12, atol=1e-300)
-    np.testing.assert_allclose(fast.dop, slow.dop, rtol=1e-12, atol=1e-15)
 
 
 @pytest.mark.parametrize("k", [1e-8, 1e-4, 0.0])

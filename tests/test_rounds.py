@@ -69,8 +69,7 @@ PLUGIN = textwrap.dedent('''
         parameters = (Parameter("e2", "", Uniform(0.5, 1.0), 0.95, "analyser efficiency", physical=(0.0, 1.0)),)
         description = "Leaky analyser: measured DOP = e2 x true DOP."
         def modify_stokes(self, ctx, total):
-            total[1:] *= ctx["e2"]
-            return total
+            return total.at[1:].multiply(ctx["e2"])
 ''')
 
 

@@ -2,6 +2,8 @@
 woven outer layer). Fibres lying along the surface scatter light that arrives and leaves near
 grazing; many scattering events leave it unpolarized. So it brightens grazing geometries and
 lowers their DOP, which no built-in effect does in that way.
+
+The hook is JAX code (plain arithmetic here; use ``jax.numpy`` for functions).
 """
 
 from spacepol.infer.priors import Uniform

@@ -15,6 +15,10 @@ each (4 x 4 x walkers x geometries), above glibc's default mmap threshold, so ev
 page-faulted in and unmapped again. Measured on the four-wavelength PTFE likelihood (20 walkers x 7,296
 geometries): 38.7 ms per call, 11.8 of them in the kernel; with the heap kept, 22.9 ms and none. An
 explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ is kept.
+
+JAX in double precision: the forward model is JAX code, and polarization near the specular peak and
+Fresnel reflectances of nearly index-matched media need float64 (float32 loses R ~ 1e-17 and DOP's
+differences of nearly equal numbers). JAX's default is float32; spacepol switches it on for the process.
 """
 
 import ctypes
@@ -50,3 +54,9 @@ def limit_blas_threads() -> None:
     except ImportError:  # pragma: no cover - a declared dependency
         return
     threadpool_limits(1, user_api="blas")
+
+
+def use_float64() -> None:
+    import jax
+
+    jax.config.update("jax_enable_x64", True)

@@ -1,7 +1,8 @@
-"""The built-in effects (DESIGN.md's table, fixed names)."""
+"""The built-in effects (DESIGN.md's table, fixed names). Their hooks are JAX code (see ``effect``)."""
 
 from __future__ import annotations
 
+import jax.numpy as jnp
 import numpy as np
 
 from ..infer.priors import Uniform
@@ -49,8 +50,6 @@ class Specular(Effect):
     def specular_lobe(self, ctx: Context, factor=None):
         """The lobe times ``factor`` (the product of the shadowing factors, or None)."""
         geo = ctx.geometry
-        if not ctx.mueller and self._fast_path_applies(ctx):
-            return self._fast_stokes(ctx, factor)
         scalar = ctx["ks"] * self.distribution(ctx) * geo.specular_jacobian
         if factor is not None:
             scalar = scalar * factor
@@ -59,40 +58,15 @@ class Specular(Effect):
                 r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             else:
                 r_s, r_p = fresnel.amplitudes(ctx["n"] + 1j * ctx["k"], geo.cos_beta, geo.sin2_beta)
-            cos_2in, sin_2in = geo.cached("two_eta_i", lambda: (np.cos(2 * geo.eta_i), np.sin(2 * geo.eta_i)))
-            return fresnel.rotated_mueller(r_s, r_p, cos_2in, sin_2in, geo.cos_2eta_r, geo.sin_2eta_r, scalar)
+            return fresnel.rotated_mueller(r_s, r_p, geo.cos_2eta_i, geo.sin_2eta_i, geo.cos_2eta_r, geo.sin_2eta_r, scalar)
         if ctx.fresnel_amplitudes is not None:
             r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
-            big_rs, big_rp = np.abs(r_s) ** 2, np.abs(r_p) ** 2
+            big_rs, big_rp = jnp.abs(r_s) ** 2, jnp.abs(r_p) ** 2
         else:
             big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
         half_diff = 0.5 * scalar * (big_rs - big_rp)
         s0 = 0.5 * scalar * (big_rs + big_rp)
-        return np.array(np.broadcast_arrays(s0, half_diff * geo.cos_2eta_r, -half_diff * geo.sin_2eta_r, np.zeros_like(s0)))
-
-    @staticmethod
-    def _fast_path_applies(ctx):
-        """The compiled kernel covers isotropic facets, bulk Fresnel and a geometry fixed per data set."""
-        return ctx.anisotropic_slopes is None and ctx.fresnel_amplitudes is None and ctx.geometry.theta_i.ndim == 1
-
-    def _fast_stokes(self, ctx, factor):
-        from . import kernels
-
-        geo = ctx.geometry
-        n_sets = ctx.shape[0] if len(ctx.shape) == 2 else 1
-        sets = [kernels.as_sets(ctx[name], n_sets) for name in ("n", "k", "sigma", "ks")]
-        if factor is None:
-            factor = geo.cached("unit_factor", lambda: np.ones((1, geo.size)))
-        elif factor.ndim == 1:
-            factor = factor.reshape(1, -1)
-        else:
-            factor = np.ascontiguousarray(np.broadcast_to(factor, (factor.shape[0], geo.size)))
-        terms = geo.cached("specular_kernel_terms", lambda: tuple(
-            np.ascontiguousarray(t) for t in (geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta, geo.tan2_alpha,
-                                              geo.sec4_alpha * geo.specular_jacobian, geo.cos_2eta_r, geo.sin_2eta_r)))
-        out = np.empty((4, n_sets, geo.size))
-        kernels.specular_stokes(*sets, *terms, factor, ctx.facet_shape == "ggx", out)
-        return out if len(ctx.shape) == 2 else out[:, 0]
+        return jnp.stack(jnp.broadcast_arrays(s0, half_diff * geo.cos_2eta_r, -half_diff * geo.sin_2eta_r, jnp.zeros_like(s0)))
 
 
 class Shadowing(Effect):
@@ -117,13 +91,7 @@ class Shadowing(Effect):
     removable = True
 
     def specular_factor(self, ctx):
-        params = [ctx[name] for name in PAPER_CONSTANTS]
-        constant = all(np.ndim(v) == 0 or np.all(v == np.asarray(v).flat[0]) for v in params)
-        if ctx.geometry.theta_i.ndim == 1 and constant:
-            # the usual case: constants fixed, so G is a geometry-only term computed once
-            values = tuple(float(np.asarray(v).flat[0]) for v in params)
-            return ctx.geometry.cached(("paper_shadowing",) + values, lambda: paper_shadowing(ctx.geometry, *values))
-        return paper_shadowing(ctx.geometry, *params)
+        return paper_shadowing(ctx.geometry, *(ctx[name] for name in PAPER_CONSTANTS))
 
 
 class Smith(Effect):
@@ -145,12 +113,11 @@ class Smith(Effect):
     def specular_factor(self, ctx):
         geo = ctx.geometry
         g1 = facets.smith_g1_ggx if ctx.facet_shape == "ggx" else self.beckmann_g1
-        tan_i = np.sqrt(1.0 - geo.cos_ti**2) / geo.cos_ti
-        tan_r = np.sqrt(1.0 - geo.cos_tr**2) / geo.cos_tr
+        tan_i, tan_r = geo.tan_ti, geo.tan_tr
         if ctx.anisotropic_slopes is not None:
             sx, sy, psi = ctx.anisotropic_slopes
-            phi_i = np.where(geo.theta_i < 0, np.pi, 0.0)
-            phi_r = -np.radians(geo.dphi) + np.where(geo.theta_r < 0, np.pi, 0.0)
+            phi_i = jnp.where(geo.theta_i < 0, np.pi, 0.0)
+            phi_r = -jnp.radians(geo.dphi) + jnp.where(geo.theta_r < 0, np.pi, 0.0)
             var_i = facets.slope_widths(sx, sy, psi, phi_i)[1]
             var_r = facets.slope_widths(sx, sy, psi, phi_r)[1]
         else:
@@ -215,7 +182,7 @@ def _transmission(n, k, cos_t):
     sin2 = 1.0 - cos_t**2
     r_s, r_p = fresnel.power(n, k, cos_t, sin2, sin2 / cos_t)
     t_s, t_p = 1.0 - r_s, 1.0 - r_p
-    zero = np.zeros_like(t_s)
+    zero = jnp.zeros_like(t_s)
     return [0.5 * (t_s + t_p), 0.5 * (t_s - t_p), zero, zero]
 
 
@@ -243,7 +210,7 @@ class Subsurface(Effect):
     def lobe(self, ctx):
         n, rho = ctx["n"], ctx["rho_s"]
         recycled = 1.0 / (1.0 - fresnel.hemispherical_internal_reflectance(n) * rho)
-        return _through_interface(ctx, rho * recycled / (np.pi * n**2), n, np.zeros_like(n))
+        return _through_interface(ctx, rho * recycled / (np.pi * n**2), n, jnp.zeros_like(n))
 
 
 class Depolarization(Effect):
@@ -264,12 +231,8 @@ class Depolarization(Effect):
         d = ctx["d_spec"]
         if ctx.mueller:
             # (1 - d) M + d M00 diag(1,0,0,0): the depolarized share keeps its intensity for any input.
-            m00 = lobe[0, 0].copy()
-            lobe *= 1.0 - d
-            lobe[0, 0] += d * m00
-        else:
-            lobe[1:] *= 1.0 - d
-        return lobe
+            return (lobe * (1.0 - d)).at[0, 0].add(d * lobe[0, 0])
+        return lobe.at[1:].multiply(1.0 - d)
 
 
 class Anisotropy(Effect):
@@ -336,7 +299,7 @@ class OxideLayer(Effect):
 
     def configure(self, ctx):
         wavelength = ctx.geometry.wavelength_um
-        if wavelength is None or np.any(~np.isfinite(wavelength)):
+        if wavelength is None:  # (a NaN wavelength is caught by ``applicable`` before any fit)
             from ..errors import ParameterError
 
             raise ParameterError("oxide_layer needs the wavelength: add '# wavelength_um: ...' to the data file")
@@ -376,8 +339,7 @@ class Extinction(Effect):
     neutral = {"e": 1.0}
 
     def modify_stokes(self, ctx, total):
-        total[1:] *= ctx["e"]
-        return total
+        return total.at[1:].multiply(ctx["e"])
 
 
 class DopBias(Effect):
@@ -394,7 +356,7 @@ class DopBias(Effect):
     neutral = {"bias": 0.0}
 
     def modify_dop(self, ctx, dop):
-        return np.sqrt(dop**2 + ctx["bias"] ** 2)
+        return jnp.sqrt(dop**2 + ctx["bias"] ** 2)
 
 
 class Lambertian(Effect):
@@ -414,7 +376,7 @@ class Lambertian(Effect):
     neutral = {"rho_l": 0.0}
 
     def lobe(self, ctx):
-        return ctx.depolarized((ctx["rho_l"] / np.pi) * np.ones_like(ctx.geometry.cos_tr))
+        return ctx.depolarized((ctx["rho_l"] / np.pi) * jnp.ones_like(ctx.geometry.cos_tr))
 
 
 BUILTIN_EFFECTS = (

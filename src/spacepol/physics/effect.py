@@ -15,8 +15,15 @@ this order for every effect of the model:
 
 Lobes are arrays of shape (4, *shape) (the Stokes vector for unpolarized incidence) or
 (4, 4, *shape) (the Mueller matrix, when the caller asks for it): row operations such as
-``lobe[1:] *= f`` work on both.  ``lobe`` may also return ``ctx.depolarized(f)``, a lobe that
+``lobe.at[1:].multiply(f)`` work on both.  ``lobe`` may also return ``ctx.depolarized(f)``, a lobe that
 only scatters intensity (stored as its S0 alone).
+
+**Hooks are JAX code.** The model is compiled with ``jax.jit`` and evaluated for many parameter sets at
+once, so a hook computes with ``jax.numpy`` (``import jax.numpy as jnp``) and returns new arrays: JAX
+arrays are immutable (``lobe[1:] *= f`` becomes ``lobe = lobe.at[1:].multiply(f)``), and parameters are
+traced values (no ``float(x)``, no ``if x > 0:`` on them; use ``jnp.where``). An effect that cannot be
+traced (numpy on traced values, in-place updates, Python branches on parameters) stops the evaluation
+with one EffectError naming it.
 """
 
 from __future__ import annotations
@@ -24,7 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
-import numpy as np
+import jax.numpy as jnp
 
 from .geometry import Geometry
 from .parameter import Parameter
@@ -48,7 +55,7 @@ class Context:
 
     def zeros(self):
         lead = (4, 4) if self.mueller else (4,)
-        return np.zeros(lead + self.shape)
+        return jnp.zeros(lead + self.shape)
 
     def depolarized(self, value) -> "DepolarizedLobe":
         """A lobe whose light is unpolarized with intensity ``value`` (Mueller diag(1,0,0,0))."""
@@ -60,29 +67,19 @@ class Context:
         Used by lobes that depolarize inside the material: only how much intensity enters
         (``row``, its first element for unpolarized light) and the state it leaves in (``column``) matter.
         """
-        out = self.zeros()
         if self.mueller:
-            for i in range(4):
-                for j in range(4):
-                    out[i, j] = column[i] * row[j]
-        else:
-            for i in range(4):
-                out[i] = column[i] * row[0]
-        return out
+            return jnp.stack([jnp.stack(jnp.broadcast_arrays(*(c * r for r in row))) for c in column])
+        return jnp.stack(jnp.broadcast_arrays(*(c * row[0] for c in column)))
 
 
 @dataclass
 class DepolarizedLobe:
     """An additive lobe of unpolarized light: only S0 (M00) is non-zero, so only it is stored."""
 
-    intensity: np.ndarray
+    intensity: jnp.ndarray
 
     def add_to(self, total, mueller: bool):
-        if mueller:
-            total[0, 0] += self.intensity
-        else:
-            total[0] += self.intensity
-        return total
+        return total.at[0, 0].add(self.intensity) if mueller else total.at[0].add(self.intensity)
 
 
 class Effect:
@@ -178,7 +175,7 @@ def effect(name: str, *, stage: str, parameters=(), requires=(), description: st
 
         @effect("sheen", stage="lobe", parameters=[Parameter("a", "", Uniform(0, 1), 0.1, "...")])
         def sheen(ctx, a):
-            return ctx.depolarized(a * ctx.geometry.cos_tr / np.pi)
+            return ctx.depolarized(a * ctx.geometry.cos_tr / jnp.pi)
     """
     if stage not in _STAGES:
         raise ValueError(f"effect '{name}': unknown stage '{stage}' (choose from {sorted(_STAGES)})")

@@ -11,28 +11,28 @@ limits at normal incidence and at the specular direction for free: the macroscop
 defined from the azimuth alone, and where the half vector is parallel to a beam any facet s
 vector will do, provided the same one serves both beams.
 
-A ``Geometry`` is built once per data set; every term that does not depend on the material
-parameters is computed here, so an inversion never recomputes it.
+A ``Geometry`` holds every term that does not depend on the material parameters. Built from numpy
+angles it is numpy (reports, criticism, the data's own geometry); built from JAX arrays (inside the
+compiled forward model, or when an effect such as ``angle_offset`` moves the angles per parameter set)
+the same code computes it with ``jax.numpy``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
 _TINY = 1e-12
 
 
-def _unit(v):
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def _signed_angle(a, b, axis):
+def _signed_angle(xp, a, b, axis):
     """Angle that rotates unit vector ``a`` into ``b`` about ``axis`` (right-hand rule)."""
-    cos = np.sum(a * b, axis=-1)
-    sin = np.sum(np.cross(a, b) * axis, axis=-1)
-    return np.arctan2(sin, cos)
+    cos = xp.sum(a * b, axis=-1)
+    sin = xp.sum(xp.cross(a, b) * axis, axis=-1)
+    return xp.arctan2(sin, cos)
 
 
 @dataclass
@@ -50,13 +50,14 @@ class Geometry:
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
-        ti, tr, dp = np.broadcast_arrays(
-            np.asarray(self.theta_i, float), np.asarray(self.theta_r, float), np.asarray(self.dphi, float)
-        )
+        angles = (self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
+        xp = jnp if any(isinstance(a, jax.Array) for a in angles) else np
+        self.xp = xp
+        ti, tr, dp = xp.broadcast_arrays(*(xp.asarray(a, dtype=float) for a in angles[:3]))
         self.theta_i, self.theta_r, self.dphi = ti, tr, dp
         if self.wavelength_um is not None:
-            self.wavelength_um = np.broadcast_to(np.asarray(self.wavelength_um, float), ti.shape[-1:])
-        self._compute()
+            self.wavelength_um = xp.broadcast_to(xp.asarray(self.wavelength_um, dtype=float), ti.shape[-1:])
+        self._compute(xp)
 
     @property
     def shape(self):
@@ -72,63 +73,89 @@ class Geometry:
             self._cache[key] = compute()
         return self._cache[key]
 
+    _TERMS = ("theta_i", "theta_r", "dphi", "wavelength_um", "k_i", "k_r", "visible", "cos_ti", "cos_tr", "h",
+              "cos_beta", "sin2_beta", "sin_beta", "sin_tan_beta", "cos_alpha", "sin_alpha", "tan2_alpha", "phi_h",
+              "eta_i", "eta_r", "cos_2eta_r", "sin_2eta_r", "cos_2eta_i", "sin_2eta_i", "tan_ti", "tan_tr",
+              "specular_jacobian", "sec4_alpha")
+
+    def device_terms(self) -> dict:
+        """Every term as a JAX array (made once per geometry): what the compiled model receives. Computing
+        them outside matters: XLA on a CPU fuses a geometry-only term such as cos(2 eta) into every
+        (parameter set, geometry) element that uses it and recomputes it there (7x on the Mueller lobe)."""
+        return self.cached("device_terms", lambda: {name: None if getattr(self, name) is None else jnp.asarray(getattr(self, name))
+                                                    for name in self._TERMS})
+
+    @classmethod
+    def from_terms(cls, terms: dict, all_visible: bool) -> "Geometry":
+        """A geometry made of ``device_terms`` (inside compiled code), without computing anything."""
+        geo = cls.__new__(cls)
+        geo._cache, geo.xp, geo.all_visible = {}, jnp, all_visible
+        for name, value in terms.items():
+            setattr(geo, name, value)
+        return geo
+
     def with_offset(self, delta_deg) -> "Geometry":
         """The same measurements seen through a goniometer whose zero is off by ``delta_deg``."""
-        delta = np.asarray(delta_deg, float)  # scalar, or (P, 1) for P parameter sets
+        delta = delta_deg  # scalar, or (P, 1) for P parameter sets
         return Geometry(self.theta_i + delta, self.theta_r + delta, self.dphi, self.wavelength_um)
 
-    def _compute(self):
-        ti = np.radians(self.theta_i)
-        tr = np.radians(self.theta_r)
-        phi_r = -np.radians(self.dphi)
-        zeros = np.zeros_like(ti)
+    def _compute(self, xp):
+        ti = xp.radians(self.theta_i)
+        tr = xp.radians(self.theta_r)
+        phi_r = -xp.radians(self.dphi)
+        zeros = xp.zeros_like(ti)
 
         # Direction vectors pointing away from the surface (a negative theta lies across the normal).
-        k_i = np.stack([np.sin(ti), zeros, np.cos(ti)], axis=-1)
-        k_r = np.stack([np.sin(tr) * np.cos(phi_r), np.sin(tr) * np.sin(phi_r), np.cos(tr)], axis=-1)
+        k_i = xp.stack([xp.sin(ti), zeros, xp.cos(ti)], axis=-1)
+        k_r = xp.stack([xp.sin(tr) * xp.cos(phi_r), xp.sin(tr) * xp.sin(phi_r), xp.cos(tr)], axis=-1)
         self.k_i, self.k_r = k_i, k_r
         # A source or detector pushed below the horizon (e.g. by angle_offset) sees nothing.
         self.visible = (k_i[..., 2] > 0) & (k_r[..., 2] > 0)
-        self.all_visible = bool(np.all(self.visible))
-        self.cos_ti = np.maximum(k_i[..., 2], _TINY)
-        self.cos_tr = np.maximum(k_r[..., 2], _TINY)
+        # inside compiled code visibility is data: the mask is then always applied
+        self.all_visible = bool(np.all(self.visible)) if xp is np else False
+        self.cos_ti = xp.maximum(k_i[..., 2], _TINY)
+        self.cos_tr = xp.maximum(k_r[..., 2], _TINY)
 
         # Half vector = facet normal for specular reflection.  eq 2: cos(2 beta) = k_i . k_r
         h_sum = k_i + k_r
-        norm = np.linalg.norm(h_sum, axis=-1)
-        h = h_sum / np.maximum(norm, _TINY)[..., None]
+        norm = xp.linalg.norm(h_sum, axis=-1)
+        h = h_sum / xp.maximum(norm, _TINY)[..., None]
         self.h = h
-        self.cos_beta = np.clip(norm / 2.0, 0.0, 1.0)
-        self.sin2_beta = np.clip(1.0 - self.cos_beta**2, 0.0, 1.0)
-        self.sin_beta = np.sqrt(self.sin2_beta)
-        self.sin_tan_beta = self.sin2_beta / np.maximum(self.cos_beta, _TINY)
+        self.cos_beta = xp.clip(norm / 2.0, 0.0, 1.0)
+        self.sin2_beta = xp.clip(1.0 - self.cos_beta**2, 0.0, 1.0)
+        self.sin_beta = xp.sqrt(self.sin2_beta)
+        self.sin_tan_beta = self.sin2_beta / xp.maximum(self.cos_beta, _TINY)
         # eq 3: cos(alpha) = (cos ti + cos tr) / (2 cos beta) = h_z
-        self.cos_alpha = np.clip(h[..., 2], _TINY, 1.0)
-        h_xy = np.hypot(h[..., 0], h[..., 1])
+        self.cos_alpha = xp.clip(h[..., 2], _TINY, 1.0)
+        h_xy = xp.hypot(h[..., 0], h[..., 1])
         self.sin_alpha = h_xy
         self.tan2_alpha = (h_xy / self.cos_alpha) ** 2
         # Azimuth of the facet normal; at alpha = 0 take the plane of incidence (phi = 0),
         # the limit along the specular plane.
-        self.phi_h = np.where(h_xy > _TINY, np.arctan2(h[..., 1], h[..., 0]), 0.0)
+        self.phi_h = xp.where(h_xy > _TINY, xp.arctan2(h[..., 1], h[..., 0]), 0.0)
 
         # Stokes bases.  Macroscopic s vectors come from the azimuth alone, so they have a
         # limit at normal incidence: s = z x (azimuth unit vector).
-        s_in = np.stack([zeros, np.ones_like(ti), zeros], axis=-1)  # phi_i = 0
-        s_out = np.stack([-np.sin(phi_r), np.cos(phi_r), zeros], axis=-1)
+        s_in = xp.stack([zeros, xp.ones_like(ti), zeros], axis=-1)  # phi_i = 0
+        s_out = xp.stack([-xp.sin(phi_r), xp.cos(phi_r), zeros], axis=-1)
         # A source or detector with negative theta sits at azimuth + 180 deg.
-        s_in = s_in * np.where(ti < 0, -1.0, 1.0)[..., None]
-        s_out = s_out * np.where(tr < 0, -1.0, 1.0)[..., None]
+        s_in = s_in * xp.where(ti < 0, -1.0, 1.0)[..., None]
+        s_out = s_out * xp.where(tr < 0, -1.0, 1.0)[..., None]
         # Facet s vector: normal to the plane containing k_i, h (and k_r).
-        s_f = np.cross(h, k_i)
-        s_f_norm = np.linalg.norm(s_f, axis=-1, keepdims=True)
-        s_f = np.where(s_f_norm > 1e-9, s_f / np.maximum(s_f_norm, _TINY), s_in)
+        s_f = xp.cross(h, k_i)
+        s_f_norm = xp.linalg.norm(s_f, axis=-1, keepdims=True)
+        s_f = xp.where(s_f_norm > 1e-9, s_f / xp.maximum(s_f_norm, _TINY), s_in)
         d_in, d_out = -k_i, k_r
         # eta_i rotates the incident (macro) basis into the facet basis about the incident
         # propagation direction; eta_r rotates the facet exit basis into the macro exit basis.
-        self.eta_i = _signed_angle(s_in, s_f, d_in)
-        self.eta_r = _signed_angle(s_f, s_out, d_out)
-        self.cos_2eta_r = np.cos(2 * self.eta_r)
-        self.sin_2eta_r = np.sin(2 * self.eta_r)
+        self.eta_i = _signed_angle(xp, s_in, s_f, d_in)
+        self.eta_r = _signed_angle(xp, s_f, s_out, d_out)
+        self.cos_2eta_r = xp.cos(2 * self.eta_r)
+        self.sin_2eta_r = xp.sin(2 * self.eta_r)
+        self.cos_2eta_i = xp.cos(2 * self.eta_i)
+        self.sin_2eta_i = xp.sin(2 * self.eta_i)
+        self.tan_ti = xp.sqrt(1.0 - self.cos_ti**2) / self.cos_ti
+        self.tan_tr = xp.sqrt(1.0 - self.cos_tr**2) / self.cos_tr
 
         # Common factor of the specular lobe: 1 / (4 cos^4(alpha) cos(ti) cos(tr)); the facet
         # distribution supplies the rest (eq 20 = D(alpha) * G * F / (4 cos ti cos tr)).

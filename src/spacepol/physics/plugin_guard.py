@@ -7,6 +7,7 @@ from __future__ import annotations
 import traceback
 from contextlib import contextmanager
 
+import jax
 import numpy as np
 
 from ..errors import SpacepolError
@@ -36,6 +37,23 @@ def culprit(effects, exc: BaseException):
             match = next((e for e in plugins if type(e).__module__ == module), None)
         found = match or found
     return found
+
+
+_TRACING_ERRORS = (jax.errors.TracerArrayConversionError, jax.errors.ConcretizationTypeError,
+                   jax.errors.TracerBoolConversionError, jax.errors.TracerIntegerConversionError)
+
+
+def untraceable(effect, exc: BaseException) -> EffectError | None:
+    """The EffectError for a hook JAX cannot compile (numpy on traced values, an in-place update, a
+    Python branch on a parameter), or None when ``exc`` is another failure."""
+    immutable = isinstance(exc, TypeError) and ("immutable" in str(exc) or "does not support item assignment" in str(exc))
+    if not (immutable or isinstance(exc, _TRACING_ERRORS)):
+        return None
+    why = ("updates an array in place (JAX arrays are immutable: write lobe = lobe.at[1:].multiply(f))" if immutable
+           else f"uses a traced value where a concrete one is needed ({type(exc).__name__}: numpy calls, float() or "
+                "Python if on parameters)")
+    return EffectError(f"effect '{effect.name}' ({type(effect).__module__}) cannot be compiled by JAX: it {why}; "
+                       "write its hooks with jax.numpy (see spacepol.physics.effect)")
 
 
 def effect_failure(effect, exc: BaseException) -> EffectError:

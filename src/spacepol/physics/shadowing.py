@@ -14,22 +14,22 @@ along the plane of incidence, where cos = +-1 and tan b_p -> tan(theta_i).
 
 from __future__ import annotations
 
-import numpy as np
+import jax.numpy as jnp
 
 PAPER_CONSTANTS = {"sigma_p": 0.0136, "sigma_r": 0.0136, "u_p": 9.0, "v_p": 1.0}
 
 
 def paper_shadowing(geo, sigma_p, sigma_r, u_p, v_p):
-    ti, tr = np.radians(geo.theta_i), np.radians(geo.theta_r)
-    cos_phi_r = np.cos(np.radians(geo.dphi))
+    ti, tr = jnp.radians(geo.theta_i), jnp.radians(geo.theta_r)
+    cos_phi_r = jnp.cos(jnp.radians(geo.dphi))
     horizontal = 2.0 * geo.sin_alpha * geo.cos_beta  # |(k_i + k_r)_xy|
     at_peak = horizontal < 1e-9
-    safe = np.where(at_peak, 1.0, horizontal)
-    proj_i = np.where(at_peak, 1.0, (np.sin(ti) + np.sin(tr) * cos_phi_r) / safe)
-    proj_r = np.where(at_peak, -1.0, (np.sin(tr) + np.sin(ti) * cos_phi_r) / safe)
-    tan_ip = np.tan(ti) * proj_i
-    tan_rp = np.tan(tr) * proj_r
-    tan_bp = np.where(at_peak, np.abs(np.tan(ti)), np.abs(np.cos(ti) - np.cos(tr)) / safe)
+    safe = jnp.where(at_peak, 1.0, horizontal)
+    proj_i = jnp.where(at_peak, 1.0, (jnp.sin(ti) + jnp.sin(tr) * cos_phi_r) / safe)
+    proj_r = jnp.where(at_peak, -1.0, (jnp.sin(tr) + jnp.sin(ti) * cos_phi_r) / safe)
+    tan_ip = jnp.tan(ti) * proj_i
+    tan_rp = jnp.tan(tr) * proj_r
+    tan_bp = jnp.where(at_peak, jnp.abs(jnp.tan(ti)), jnp.abs(jnp.cos(ti) - jnp.cos(tr)) / safe)
     w_p = sigma_p * (1.0 + u_p * geo.sin_alpha / (geo.sin_alpha + v_p * geo.cos_alpha))
-    numerator = 1.0 + w_p * np.abs(tan_ip * tan_rp) / (1.0 + sigma_r * tan_bp)
+    numerator = 1.0 + w_p * jnp.abs(tan_ip * tan_rp) / (1.0 + sigma_r * tan_bp)
     return numerator / ((1.0 + w_p * tan_ip**2) * (1.0 + w_p * tan_rp**2))

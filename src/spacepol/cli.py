@@ -131,6 +131,16 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="FILE", help="write the rungs here (default DIR/ladder.json)")
     p.add_argument("--out", default="reports/ladder")
 
+    p = sub.add_parser("batch", help="one inversion per row of a manifest, on a process pool or a Dask cluster")
+    p.add_argument("manifest", metavar="MANIFEST.csv",
+                   help="columns id, data (relative to the manifest), optional model, observables, prior, seed, wavelength_um")
+    p.add_argument("--executor", default="local", choices=["local", "dask"],
+                   help="local process pool (default) or Dask distributed (a LocalCluster unless --scheduler)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--workers", type=_int_at_least(1), default=None, help="local workers (default: one per core)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--out", default="reports/batch")
+
     p = sub.add_parser("sky", help="the sun (astropy) and the sky's polarization at a site and time; maps")
     p.add_argument("--lat", type=_finite(), required=True, metavar="DEG", help="latitude, north positive")
     p.add_argument("--lon", type=_finite(), required=True, metavar="DEG", help="longitude, east positive")

@@ -419,6 +419,17 @@ def replay_steps(path, model: Model) -> list[str]:
     return [s for s in steps if isinstance(s, str)]
 
 
+def batch(args) -> int:
+    from .batch import run_batch
+
+    rows = run_batch(args.manifest, args.out, executor=args.executor, scheduler=args.scheduler, workers=args.workers,
+                     progress=not args.quiet)
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("ok", "skipped", "failed")}
+    print(f"wrote {args.out}/results.csv: {counts['ok']} ok, {counts['skipped']} skipped (finished before), "
+          f"{counts['failed']} failed" + ("".join(f"\n  failed {r['id']}: {r['error']}" for r in rows if r["status"] == "failed")))
+    return 1 if counts["failed"] else 0
+
+
 def _parse_direction(text: str) -> tuple[float, float]:
     try:
         zen, az = (float(v) for v in text.split(","))

@@ -5,19 +5,28 @@ Each observable has channels, each a vector over the geometries; per channel the
 errors or an inferred nuisance level (one per channel group, declared by the observable). Gaussian, or
 Student-t with ``robust=True``. The pointwise log-likelihood (one entry per channel and geometry, in
 the order of ``observables``) is kept for PSIS-LOO.
+
+The log-likelihood is one compiled JAX function of the parameter sets: the model's evaluation, the
+observables' predictions, residuals and densities fused, so no Mueller matrix or residual array of
+sets x geometries is written to memory when only the sum per set is wanted (``total``, what the samplers
+and optimizers call).
 """
 
 from __future__ import annotations
 
 import math
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 from scipy.special import gammaln
 
 from .. import observables as obs
 from ..errors import ParameterError
 from ..io.measurements import Dataset
-from ..physics.model import Model
+from ..observables.base import array_module
+from ..physics.compiled import Program, padded
+from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
 
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
@@ -76,6 +85,7 @@ class Likelihood:
         # observation names that say where a point is (Pareto-k warnings quote them)
         self.labels = [f"{ch}[{i}] (theta_i {data.theta_i[i]:g}, theta_r {data.theta_r[i]:g}, dphi {data.dphi[i]:g} deg)"
                        for ch in self.observables for i in range(len(data))]
+        self._jitted = None  # (pointwise, total), compiled at the first call
 
     @property
     def batch_sets(self) -> int:
@@ -126,15 +136,56 @@ class Likelihood:
         return self._owner[channel].replicate(channel, mu, scale, self.inferred(channel), rng)
 
     def pointwise(self, params: dict) -> np.ndarray:
-        """Log-likelihood per observation, shape (P, n_obs), for P parameter sets."""
+        """Log-likelihood per observation, shape (P, n_obs), for P parameter sets (model and noise parameters)."""
+        return self._call(0, params)
+
+    def total(self, params: dict) -> np.ndarray:
+        """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept)."""
+        return self._call(1, params)
+
+    def _call(self, which: int, params: dict) -> np.ndarray:
+        if self._jitted is None:
+            self._jitted = self._compile()
+        values, n_sets = {}, 0
+        for name, v in params.items():
+            if np.ndim(v) == 0:
+                values[name] = float(v)
+            else:
+                v = np.asarray(v, float).reshape(-1)
+                values[name], n_sets = v[:, None], max(n_sets, v.size)
+        out = np.asarray(self._jitted[which](padded(values, n_sets), self._inputs))
+        return out[:n_sets] if n_sets else out
+
+    def _compile(self):
+        program = Program(self.model, self.geometry, self.needs_mueller)
         model_names = {p.name for p in self.model.parameters}
-        pred = self.predict({k: v for k, v in params.items() if k in model_names})
-        blocks = [self._logpdf(ch, self.residual(ch, pred[ch]), self.scale(ch, params)) for ch in self.observables]
-        return np.concatenate(blocks, axis=-1)
+        mueller = self.needs_mueller
+        self._inputs = {"model": program.inputs, "y": {ch: jnp.asarray(y) for ch, y in self._y.items()},
+                        "errors": {ch: jnp.asarray(e) for ch, e in self._errors.items()},
+                        "profiles": {ch: jnp.asarray(f) for ch, f in self._profile.items()}}
+
+        def pointwise(values, inputs):
+            total, dop = program({k: v for k, v in values.items() if k in model_names}, inputs["model"])
+            prediction = Prediction(stokes=total[:, 0] if mueller else total, dop=dop, mueller=total if mueller else None)
+            predicted = {}
+            for o in self.objects:
+                predicted.update(o.predict(prediction))
+            blocks = []
+            for ch in self.observables:
+                if ch in inputs["errors"]:
+                    scale = inputs["errors"][ch]
+                else:
+                    scale = values[self.noise_parameter(ch)] * inputs["profiles"].get(ch, 1.0)
+                resid = self._owner[ch].residual(ch, inputs["y"][ch], predicted[ch], self.inferred(ch))
+                blocks.append(jnp.broadcast_to(self._logpdf(ch, resid, scale), jnp.shape(predicted[ch])))
+            return jnp.concatenate(blocks, axis=-1)
+
+        return jax.jit(pointwise), jax.jit(lambda values, inputs: pointwise(values, inputs).sum(axis=-1))
 
     def _logpdf(self, channel, resid, scale):
         if not self.robust:
             return self._owner[channel].log_density(resid, scale)
+        xp = array_module(resid, scale)
         nu = self.nu
         const = gammaln((nu + 1) / 2) - gammaln(nu / 2) - 0.5 * math.log(nu * math.pi)
-        return const - np.log(scale) - 0.5 * (nu + 1) * np.log1p((resid / scale) ** 2 / nu)
+        return const - xp.log(scale) - 0.5 * (nu + 1) * xp.log1p((resid / scale) ** 2 / nu)

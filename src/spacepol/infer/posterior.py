@@ -41,7 +41,7 @@ class Posterior:
             raise ParameterError(f"{where}: the prior density is zero at every one of {len(theta)} draws from it")
         if self.prior_only:
             return
-        ll = self.log_prob_pointwise(theta).sum(axis=-1)
+        ll = self.likelihood.total(self.priors.to_params(theta))
         if not np.any(np.isfinite(ll)):
             raise ParameterError(
                 f"{self.likelihood.data.source}: the likelihood is not finite at any of {len(theta)} draws from the "
@@ -68,7 +68,7 @@ class Posterior:
         if self.prior_only:
             return lp
         if np.any(inside):
-            ll = self.log_prob_pointwise(theta[inside]).sum(axis=-1)
+            ll = self.likelihood.total(self.priors.to_params(theta[inside]))
             self.n_evaluations += int(inside.sum())
             lp[inside] += np.where(np.isfinite(ll), ll, -np.inf)
         return lp

@@ -12,12 +12,13 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import ColumnObservable
+from .base import ColumnObservable, array_module
 
 
 def wrap_deg(angle):
     """An angle difference brought into [-90, 90) deg (AoP is defined modulo 180 deg)."""
-    return (np.asarray(angle) + 90.0) % 180.0 - 90.0
+    xp = array_module(angle)
+    return (xp.asarray(angle) + 90.0) % 180.0 - 90.0
 
 
 class AoP(ColumnObservable):

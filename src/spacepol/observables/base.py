@@ -7,17 +7,27 @@ modelled (the file's errors per row, or one inferred noise level for its channel
 density, how replicate data are drawn and its ArviZ dimensions. The likelihood, the residual analysis,
 the figures and the InferenceData use channels generically; adding an observable is one new file
 registered in ``observables/__init__.py``.
+
+``predict``, ``residual`` and ``log_density`` also run inside the compiled likelihood, on JAX arrays:
+they compute with ``array_module(...)`` (numpy for numpy arrays, jax.numpy for JAX ones).
 """
 
 from __future__ import annotations
 
 import math
 
+import jax
+import jax.numpy as jnp
 import numpy as np
 
 from ..physics.parameter import Parameter
 
 _LOG_2PI = math.log(2 * math.pi)
+
+
+def array_module(*arrays):
+    """jax.numpy when any of ``arrays`` is a JAX array (inside the compiled likelihood), else numpy."""
+    return jnp if any(isinstance(a, jax.Array) for a in arrays) else np
 
 
 class Observable:
@@ -52,6 +62,9 @@ class Observable:
 
     def log_density(self, resid, scale):
         """Gaussian log density of the residuals at noise ``scale`` (same shape, broadcast)."""
+        xp = array_module(resid, scale)
+        if xp is jnp:
+            return -0.5 * jnp.square(resid / scale) - (jnp.log(scale) + 0.5 * _LOG_2PI)
         z = np.divide(resid, scale)  # in place from here: full-Mueller data make these arrays megabytes
         np.square(z, out=z)
         z *= -0.5

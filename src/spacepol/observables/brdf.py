@@ -7,7 +7,7 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import ColumnObservable
+from .base import ColumnObservable, array_module
 
 _FLOOR = 1e-300
 
@@ -24,7 +24,8 @@ class BRDF(ColumnObservable):
 
     def residual(self, channel, y, mu, inferred):
         if inferred:
-            return np.log(np.maximum(y, _FLOOR)) - np.log(np.maximum(mu, _FLOOR))
+            xp = array_module(y, mu)
+            return xp.log(xp.maximum(y, _FLOOR)) - xp.log(xp.maximum(mu, _FLOOR))
         return y - mu
 
     def replicate(self, channel, mu, scale, inferred, rng):

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import Observable
+from .base import Observable, array_module
 
 ELEMENTS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]
 GROUPS = {"pol": ("m12", "m13", "m14", "m21", "m31", "m41"), "lin": ("m22", "m23", "m32", "m33"),
@@ -31,7 +31,8 @@ def index(element: str) -> tuple[int, int]:
 
 def normalised(mueller) -> dict[str, np.ndarray]:
     """{m_ij: M_ij / M_11} from a (4, 4, ...) Mueller array (0 where M_11 = 0)."""
-    m11 = np.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)  # divide, not multiply by 1/M11: M11 may be subnormal
+    xp = array_module(mueller)
+    m11 = xp.where(mueller[0, 0] > 0, mueller[0, 0], np.inf)  # divide, not multiply by 1/M11: M11 may be subnormal
     return {e: mueller[index(e)] / m11 for e in ELEMENTS}
 
 

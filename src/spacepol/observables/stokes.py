@@ -8,11 +8,11 @@ import numpy as np
 
 from ..infer.priors import LogUniform
 from ..physics.parameter import Parameter
-from .base import Observable
+from .base import Observable, array_module
 
 
 def _normalised(stokes, row):
-    s0 = np.where(stokes[0] > 0, stokes[0], np.inf)
+    s0 = array_module(stokes).where(stokes[0] > 0, stokes[0], np.inf)
     return stokes[row] / s0
 
 

@@ -93,7 +93,7 @@ class SpectralModel:
         out = {k: params[k] for k in self.shared if k in params}
         for name in self.spectral:
             if self.dispersion.get(name) == "cauchy":
-                out[name] = np.asarray(params["n_cauchy_a"]) + np.asarray(params["n_cauchy_b"]) / lam**2
+                out[name] = params["n_cauchy_a"] + params["n_cauchy_b"] / lam**2
             elif f"{name}@{label}" in params:
                 out[name] = params[f"{name}@{label}"]
         return out
@@ -127,6 +127,15 @@ class SpectralModel:
                                      f"{', '.join(self.labels)} um")
             self._geometries[key] = (geometry, groups)  # the geometry is kept so its id stays unique
         return self._geometries[key][1]
+
+    @property
+    def inner(self) -> Model:
+        return self.model
+
+    def parts(self, geometry: Geometry) -> list:
+        """[(rows, geometry of those rows, params -> the inner model's params)], one part per wavelength."""
+        return [(idx, sub, lambda values, j=j: self.values_at(values, j))
+                for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
 
     def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
         parts = [(idx, self.model.evaluate(self.values_at(params, j), sub, mueller=mueller, check=check))

@@ -1,0 +1,148 @@
+"""The model's evaluation as one JAX function, and what it takes to make XLA run it fast on a CPU.
+
+``evaluate_values`` calls the effects' hooks in their order (``effect``'s docstring) on traced values;
+``jitted`` compiles it once per model structure (built-in effects by class, plug-ins by instance), output
+kind and fixed values, shared by every Model built from the same effects; ``Program`` is the evaluation
+over all rows of a data set for a Model or a SpectralModel (one part per wavelength), for callers that
+compile more around it (the likelihood). Parameter sets are padded to ``bucket`` sizes so the walkers,
+batches and remainders of an inversion do not each compile a program.
+
+Two rules keep XLA fast on a CPU: terms that depend on the geometry alone are computed outside
+(``Geometry.device_terms``) or held behind a barrier (``once``), since XLA otherwise fuses them into every
+(parameter set, geometry) element that uses them and recomputes their trigonometry there; and the
+additive lobes are added as whole arrays, not scattered into one.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .builtin_effects import Specular
+from .effect import Context, DepolarizedLobe
+from .geometry import Geometry
+from .plugin_guard import is_plugin
+
+_JITTED: dict = {}
+
+
+def degree_of_polarization(stokes):
+    """|S_pol| / S0 (0 where S0 = 0), numpy or JAX arrays."""
+    xp = jnp if isinstance(stokes, jax.Array) else np
+    s0 = stokes[0]
+    pol = xp.sqrt(stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2)
+    lit = s0 > 0
+    # |S| <= S0 holds for every lobe; rounding may push a ratio an ulp above 1.
+    return xp.where(lit, xp.minimum(pol / xp.where(lit, s0, 1.0), 1.0), 0.0)
+
+
+def bucket(n_sets: int) -> int:
+    """Parameter sets are padded to this many: powers of two up to 64, then multiples of a quarter of the
+    largest power of two below (at most 25 % padding, four compiled sizes per octave)."""
+    if n_sets <= 64:
+        return 1 << max(0, (n_sets - 1).bit_length())
+    step = (1 << (n_sets.bit_length() - 1)) // 4
+    return -(-n_sets // step) * step
+
+
+def padded(values: dict, n_sets: int) -> dict:
+    """``values`` with every (n_sets, 1) array padded to ``bucket(n_sets)`` rows by repeating its last row
+    (always a valid parameter set); scalars and other shapes as they are."""
+    extra = bucket(n_sets) - n_sets if n_sets else 0
+    if not extra:
+        return values
+    return {k: np.pad(v, ((0, extra), (0, 0)), mode="edge") if np.shape(v)[:1] == (n_sets,) and np.ndim(v) == 2 else v
+            for k, v in values.items()}
+
+
+def batch_of(values: dict) -> tuple:
+    """(P,) for values holding P parameter sets as (P, 1) arrays, () for scalars only."""
+    sizes = [np.shape(v)[0] for v in values.values() if np.ndim(v) == 2]
+    return (max(sizes),) if sizes else ()
+
+
+def once(value, shape):
+    """A hook's output that does not vary over parameter sets (the paper's shadowing at fixed constants)
+    computed once: without the barrier XLA fuses it into every (set, geometry) element that uses it."""
+    if value is None or len(shape) < 2 or np.ndim(value) == 0 or np.shape(value)[-2:-1] == shape[-2:-1]:
+        return value
+    return jax.lax.optimization_barrier(value)
+
+
+def evaluate_values(effects, values: dict, batch: tuple, geometry: Geometry, mueller: bool):
+    """The effects' hooks in their order: (Stokes (4, ...) or Mueller (4, 4, ...) total, measured DOP)."""
+    geo = geometry
+    for e in effects:
+        geo = e.transform_geometry(values, geo)
+    shape = np.broadcast_shapes(batch + (1,) if batch else (), geo.shape)
+    ctx = Context(values, geo, mueller, shape)
+    for e in effects:
+        e.configure(ctx)
+
+    specular = next((e for e in effects if isinstance(e, Specular)), None)
+    if specular is not None:
+        factor = None
+        for e in effects:
+            f = once(e.specular_factor(ctx), shape)
+            if f is not None:
+                factor = f if factor is None else factor * f
+        total = specular.specular_lobe(ctx, factor)
+        for e in effects:
+            total = e.modify_specular(ctx, total)
+    else:
+        total = ctx.zeros()
+    lead = (4, 4) if mueller else (4,)
+    total = jnp.broadcast_to(total, lead + shape)
+    for e in effects:
+        extra = e.lobe(ctx)
+        if isinstance(extra, DepolarizedLobe):
+            total = DepolarizedLobe(once(extra.intensity, shape)).add_to(total, mueller)
+        elif extra is not None:
+            total = total + extra
+    for e in effects:
+        total = e.modify_stokes(ctx, total)
+    if not geo.all_visible:
+        total = jnp.where(geo.visible, total, 0.0)
+    dop = degree_of_polarization(total[:, 0] if mueller else total)
+    for e in effects:
+        dop = e.modify_dop(ctx, dop)
+    return total, dop
+
+
+def jitted(effects, fixed: dict, mueller: bool, all_visible: bool):
+    """The compiled evaluation ``run(traced values, geometry.device_terms()) -> (total, dop)``; ``fixed``
+    values (parameters nobody set) are compiled in as constants."""
+    key = (tuple(e if is_plugin(e) else type(e) for e in effects), mueller, tuple(sorted(fixed.items())), all_visible)
+    if key not in _JITTED:
+        def run(traced, terms):
+            return evaluate_values(effects, {**fixed, **traced}, batch_of(traced), Geometry.from_terms(terms, all_visible), mueller)
+
+        _JITTED[key] = jax.jit(run)
+    return _JITTED[key]
+
+
+class Program:
+    """A Model's or SpectralModel's evaluation over all rows of one geometry as a pure function of traced
+    parameter values: ``program(values, program.inputs) -> (total, dop)`` in the rows' order."""
+
+    def __init__(self, model, geometry: Geometry, mueller: bool):
+        inner = model.inner
+        self.effects, self.defaults, self.mueller = inner.effects, inner.defaults(), mueller
+        self.parts = model.parts(geometry)  # [(rows, sub-geometry, values -> the inner model's values)]
+        order = np.concatenate([np.arange(geometry.size)[rows] for rows, _, _ in self.parts])
+        self.inverse = None if np.array_equal(order, np.arange(geometry.size)) else jnp.asarray(np.argsort(order))
+        self.inputs = [sub.device_terms() for _, sub, _ in self.parts]
+
+    def __call__(self, values: dict, inputs):
+        batch = batch_of(values)
+        outputs = [evaluate_values(self.effects, {**self.defaults, **inner_values(values)}, batch,
+                                   Geometry.from_terms(terms, sub.all_visible), self.mueller)
+                   for (_, sub, inner_values), terms in zip(self.parts, inputs)]
+        if len(outputs) == 1:
+            return outputs[0]
+        total = jnp.concatenate([t for t, _ in outputs], axis=-1)
+        dop = jnp.concatenate([d for _, d in outputs], axis=-1)
+        if self.inverse is not None:
+            total, dop = total[..., self.inverse], dop[..., self.inverse]
+        return total, dop

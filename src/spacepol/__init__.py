@@ -7,8 +7,8 @@ measurements in :mod:`spacepol.io`, inference in :mod:`spacepol.infer`, reportin
 
 __version__ = "0.1.0"
 
-from ._runtime import keep_heap, limit_blas_threads, use_float64
+from ._runtime import configure_jax, keep_heap, limit_blas_threads
 
 limit_blas_threads()
 keep_heap()
-use_float64()
+configure_jax()

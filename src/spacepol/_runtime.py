@@ -19,6 +19,12 @@ explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ is kept.
 JAX in double precision: the forward model is JAX code, and polarization near the specular peak and
 Fresnel reflectances of nearly index-matched media need float64 (float32 loses R ~ 1e-17 and DOP's
 differences of nearly equal numbers). JAX's default is float32; spacepol switches it on for the process.
+
+JAX's compiled programs kept on disk: every model structure and batch size is compiled once (0.2 s for the
+paper's DOP likelihood, 1-2 s for a full-Mueller one), and without a cache every command compiles them
+again. Kept in $SPACEPOL_CACHE_DIR, else $XDG_CACHE_HOME/spacepol/jax or ~/.cache/spacepol/jax, at most
+1 GB (least recently used entries go first); SPACEPOL_CACHE_DIR="" turns it off. A cache folder that
+cannot be written only costs the compilations.
 """
 
 import ctypes
@@ -56,7 +62,22 @@ def limit_blas_threads() -> None:
     threadpool_limits(1, user_api="blas")
 
 
-def use_float64() -> None:
+def configure_jax() -> None:
     import jax
 
     jax.config.update("jax_enable_x64", True)
+    folder = os.environ.get("SPACEPOL_CACHE_DIR")
+    if folder is None:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        folder = os.path.join(base, "spacepol", "jax")
+    if not folder:
+        return
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError:
+        return
+    if not os.access(folder, os.W_OK):
+        return
+    jax.config.update("jax_compilation_cache_dir", folder)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
+    jax.config.update("jax_compilation_cache_max_size", 1 << 30)

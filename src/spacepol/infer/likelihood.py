@@ -90,8 +90,10 @@ class Likelihood:
     @property
     def batch_sets(self) -> int:
         """How many parameter sets one vectorised evaluation should take: intermediate arrays of
-        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB)."""
-        return max(1, 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data)))
+        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); a power of
+        two, the size the compiled likelihood pads to anyway."""
+        sets = max(1, 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data)))
+        return 1 << (sets.bit_length() - 1)
 
     @property
     def n_obs(self) -> int:

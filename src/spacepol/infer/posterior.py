@@ -29,7 +29,7 @@ class Posterior:
         posterior.check_support(where)
         return posterior
 
-    def check_support(self, where: str = "priors", draws: int = 256) -> None:
+    def check_support(self, where: str = "priors", draws: int = 255) -> None:
         """Before any sampling: plug-in effects give finite predictions, and the posterior is finite
         somewhere in the prior support (else one line says which part is at fault).  Uses its own
         fixed-seed generator, so the user's random stream is untouched."""
@@ -68,7 +68,9 @@ class Posterior:
         if self.prior_only:
             return lp
         if np.any(inside):
-            ll = self.likelihood.total(self.priors.to_params(theta[inside]))
+            # every row is evaluated (those outside the priors are discarded after): a fixed batch size is
+            # one compiled program, where the varying count of rows inside would compile one per size
+            ll = self.likelihood.total(self.priors.to_params(theta))[inside]
             self.n_evaluations += int(inside.sum())
             lp[inside] += np.where(np.isfinite(ll), ll, -np.inf)
         return lp

@@ -38,12 +38,9 @@ def degree_of_polarization(stokes):
 
 
 def bucket(n_sets: int) -> int:
-    """Parameter sets are padded to this many: powers of two up to 64, then multiples of a quarter of the
-    largest power of two below (at most 25 % padding, four compiled sizes per octave)."""
-    if n_sets <= 64:
-        return 1 << max(0, (n_sets - 1).bit_length())
-    step = (1 << (n_sets.bit_length() - 1)) // 4
-    return -(-n_sets // step) * step
+    """Parameter sets are padded to a power of two: one compiled program per octave of batch sizes
+    (a compilation costs 0.2-2 s, more than the padded sets do; ``Likelihood.batch_sets`` is one too)."""
+    return 1 << max(0, (n_sets - 1).bit_length())
 
 
 def padded(values: dict, n_sets: int) -> dict:

@@ -17,7 +17,7 @@ from .compiled import degree_of_polarization, evaluate_values, jitted, padded
 from .effect import Effect
 from .geometry import Geometry
 from .parameter import Parameter
-from .plugin_guard import checking_outputs, culprit, effect_failure, untraceable
+from .plugin_guard import checking_outputs, culprit, effect_failure, is_plugin, untraceable
 from .registry import registry
 
 
@@ -158,6 +158,8 @@ class Model:
     def check_plugins(self, params: dict, geometry: Geometry) -> Prediction:
         """Evaluate once uncompiled, every plug-in hook's output checked for NaN/inf, then compiled (an
         EffectError names the effect that failed, returned non-finite values or cannot be traced)."""
+        if not any(is_plugin(e) for e in self.effects):  # built-in effects are not guarded: nothing to check
+            return self.evaluate(params, geometry, check=False)
         with self._naming_plugin_failures(), checking_outputs(self.effects):
             values, batch = self._resolve(params, check=False)
             values = {k: jnp.asarray(v) for k, v in values.items()}

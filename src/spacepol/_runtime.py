@@ -22,9 +22,9 @@ differences of nearly equal numbers). JAX's default is float32; spacepol switche
 
 JAX's compiled programs kept on disk: every model structure and batch size is compiled once (0.2 s for the
 paper's DOP likelihood, 1-2 s for a full-Mueller one), and without a cache every command compiles them
-again. Kept in $SPACEPOL_CACHE_DIR, else $XDG_CACHE_HOME/spacepol/jax or ~/.cache/spacepol/jax, at most
-1 GB (least recently used entries go first); SPACEPOL_CACHE_DIR="" turns it off. A cache folder that
-cannot be written only costs the compilations.
+again. Kept in $SPACEPOL_CACHE_DIR, else $XDG_CACHE_HOME/spacepol/jax or ~/.cache/spacepol/jax (entries
+of 0.1-1 MB, one per model structure and batch size; delete the folder at will); SPACEPOL_CACHE_DIR=""
+turns it off. A cache folder that cannot be written only costs the compilations.
 """
 
 import ctypes
@@ -80,4 +80,3 @@ def configure_jax() -> None:
         return
     jax.config.update("jax_compilation_cache_dir", folder)
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
-    jax.config.update("jax_compilation_cache_max_size", 1 << 30)

@@ -131,6 +131,14 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="FILE", help="write the rungs here (default DIR/ladder.json)")
     p.add_argument("--out", default="reports/ladder")
 
+    p = sub.add_parser("design", help="which further measurements would break a degeneracy (Fisher information)")
+    data_options(p)
+    p.add_argument("--picks", type=_int_at_least(1), default=3, help="measurements to propose (chosen greedily)")
+    p.add_argument("--noise", action="append", default=[], metavar="OBS=X",
+                   help="assumed noise of a new measurement: dop=0.005, brdf=0.03 (relative), mueller=0.01 "
+                        "(default: the data's own, else dop 0.01, brdf 5 %%, mueller 0.01)")
+    p.add_argument("--out", default="reports/design")
+
     p = sub.add_parser("batch", help="one inversion per row of a manifest, on a process pool or a Dask cluster")
     p.add_argument("manifest", metavar="MANIFEST.csv",
                    help="columns id, data (relative to the manifest), optional model, observables, prior, seed, wavelength_um")
@@ -174,6 +182,7 @@ def main(argv=None) -> int:
     if not os.environ.get("SPACEPOL_SHOW_WARNINGS"):  # third-party deprecation chatter is not for users
         warnings.filterwarnings("ignore", category=FutureWarning)
         warnings.filterwarnings("ignore", category=DeprecationWarning)
+        warnings.filterwarnings("ignore", module=r"jax\..*")  # e.g. an unreadable entry of the compilation cache
     from . import commands
     from .errors import SpacepolError
 

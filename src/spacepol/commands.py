@@ -419,6 +419,34 @@ def replay_steps(path, model: Model) -> list[str]:
     return [s for s in steps if isinstance(s, str)]
 
 
+def design(args) -> int:
+    from .criticism.design import design as rank_measurements
+    from .infer.optimum import find_optimum
+    from .report.design_report import write_design_report
+
+    out = check_output_dir(args.out)
+    data = load_dataset(args)
+    posterior = build_posterior(args, data)
+    print(f"design: the optimum of {posterior.likelihood.model.name} on {len(data)} geometries "
+          f"({', '.join(posterior.likelihood.observables)}), then the Fisher information of every candidate", file=sys.stderr)
+    _, theta = find_optimum(posterior, np.random.default_rng(args.seed))
+    point = {k: float(np.ravel(v)[0]) for k, v in posterior.priors.to_params(theta[None, :]).items()}
+    noise = {}
+    for item in args.noise:
+        name, sep, text = item.partition("=")
+        try:
+            noise[name.strip()] = float(text)
+        except ValueError:
+            raise ParameterError(f"--noise '{item}': expected dop=X, brdf=REL or mueller=X") from None
+        if not sep or name.strip() not in ("dop", "brdf", "mueller") or not noise[name.strip()] > 0:
+            raise ParameterError(f"--noise '{item}': expected dop=X, brdf=REL or mueller=X with X > 0")
+    report = rank_measurements(posterior, point, picks=args.picks, noise=noise)
+    lines = write_design_report(report, out, args.data)
+    print("\n".join(lines[2:3]))
+    print(f"wrote {out}/design.md, design.json, design.png")
+    return 0
+
+
 def batch(args) -> int:
     from .batch import run_batch
 

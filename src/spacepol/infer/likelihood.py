@@ -25,9 +25,14 @@ from .. import observables as obs
 from ..errors import ParameterError
 from ..io.measurements import Dataset
 from ..observables.base import array_module
-from ..physics.compiled import Program, padded
+from ..physics.compiled import Program
 from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
+
+_CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
+# the only batch sizes compiled: an emcee half-ensemble, a DE generation, larger batches in blocks; every other
+# size would be a compilation of its own (0.05-1 s each, ~10 per model in a diagnose screening before this)
+_BATCH_SIZES = (16, 64, 256)
 
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
     """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
@@ -85,15 +90,15 @@ class Likelihood:
         # observation names that say where a point is (Pareto-k warnings quote them)
         self.labels = [f"{ch}[{i}] (theta_i {data.theta_i[i]:g}, theta_r {data.theta_r[i]:g}, dphi {data.dphi[i]:g} deg)"
                        for ch in self.observables for i in range(len(data))]
-        self._jitted = None  # (pointwise, total), compiled at the first call
+        self._jitted, self._program = {}, None  # compiled at the first call, per kind and parameter layout
 
     @property
     def batch_sets(self) -> int:
         """How many parameter sets one vectorised evaluation should take: intermediate arrays of
-        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); a power of
-        two, the size the compiled likelihood pads to anyway."""
-        sets = max(1, 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data)))
-        return 1 << (sets.bit_length() - 1)
+        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); one of the
+        sizes the likelihood is compiled for."""
+        sets = 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data))
+        return max([size for size in _BATCH_SIZES if size <= sets] or [_BATCH_SIZES[0]])
 
     @property
     def n_obs(self) -> int:
@@ -146,43 +151,68 @@ class Likelihood:
         return self._call(1, params)
 
     def _call(self, which: int, params: dict) -> np.ndarray:
-        if self._jitted is None:
-            self._jitted = self._compile()
-        values, n_sets = {}, 0
+        """Parameter sets go in as one (P, K) matrix (one argument: a JAX call with a dict of arrays costs
+        ~100 us of argument handling, more than the 84-point likelihood itself); scalars are compiled in."""
+        columns, scalars, n_sets = [], {}, 0
         for name, v in params.items():
             if np.ndim(v) == 0:
-                values[name] = float(v)
+                scalars[name] = float(v)
             else:
                 v = np.asarray(v, float).reshape(-1)
-                values[name], n_sets = v[:, None], max(n_sets, v.size)
-        out = np.asarray(self._jitted[which](padded(values, n_sets), self._inputs))
-        return out[:n_sets] if n_sets else out
+                columns.append((name, v))
+                n_sets = max(n_sets, v.size)
+        key = (which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())))
+        if key not in self._jitted:
+            self._jitted[key] = self._compile(*key)
+        if not n_sets:
+            return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
+        matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
+        rows = next((size for size in _BATCH_SIZES if size >= n_sets), _BATCH_SIZES[-1])
+        if n_sets > rows:  # in blocks of the largest size
+            return np.concatenate([self._call(which, {**scalars, **{n: v[i : i + rows] for n, v in columns}})
+                                   for i in range(0, n_sets, rows)], axis=0)
+        if rows > n_sets:  # padded with the last set (a valid one)
+            matrix = np.concatenate([matrix, np.repeat(matrix[-1:], rows - n_sets, axis=0)])
+        return np.asarray(self._jitted[key](matrix))[:n_sets]
 
-    def _compile(self):
-        program = Program(self.model, self.geometry, self.needs_mueller)
+    def _compile(self, which: int, names: tuple, scalars: tuple):
+        if self._program is None:
+            self._program = Program(self.model, self.geometry, self.needs_mueller)
+        program, fixed = self._program, dict(scalars)
         model_names = {p.name for p in self.model.parameters}
         mueller = self.needs_mueller
-        self._inputs = {"model": program.inputs, "y": {ch: jnp.asarray(y) for ch, y in self._y.items()},
-                        "errors": {ch: jnp.asarray(e) for ch, e in self._errors.items()},
-                        "profiles": {ch: jnp.asarray(f) for ch, f in self._profile.items()}}
+        # the data are constants of the compiled function (as arguments they would be handled on every call)
+        y = {ch: jnp.asarray(v) for ch, v in self._y.items()}
+        errors = {ch: jnp.asarray(e) for ch, e in self._errors.items()}
+        profiles = {ch: jnp.asarray(f) for ch, f in self._profile.items()}
 
-        def pointwise(values, inputs):
-            total, dop = program({k: v for k, v in values.items() if k in model_names}, inputs["model"])
+        def pointwise(matrix):
+            values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
+            total, dop = program({k: v for k, v in values.items() if k in model_names}, program.inputs)
             prediction = Prediction(stokes=total[:, 0] if mueller else total, dop=dop, mueller=total if mueller else None)
             predicted = {}
             for o in self.objects:
                 predicted.update(o.predict(prediction))
             blocks = []
             for ch in self.observables:
-                if ch in inputs["errors"]:
-                    scale = inputs["errors"][ch]
-                else:
-                    scale = values[self.noise_parameter(ch)] * inputs["profiles"].get(ch, 1.0)
-                resid = self._owner[ch].residual(ch, inputs["y"][ch], predicted[ch], self.inferred(ch))
-                blocks.append(jnp.broadcast_to(self._logpdf(ch, resid, scale), jnp.shape(predicted[ch])))
+                scale = errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0)
+                resid = self._owner[ch].residual(ch, y[ch], predicted[ch], self.inferred(ch))
+                lp = self._logpdf(ch, resid, scale)
+                blocks.append(jnp.broadcast_to(lp, jnp.broadcast_shapes(jnp.shape(lp), (matrix.shape[0], len(self.data)))))
             return jnp.concatenate(blocks, axis=-1)
 
-        return jax.jit(pointwise), jax.jit(lambda values, inputs: pointwise(values, inputs).sum(axis=-1))
+        def total(matrix):
+            # chunks of sets small enough that the sets x geometries intermediates stay in the CPU's cache:
+            # above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2 at 64)
+            n_sets = matrix.shape[0]
+            chunk = _CACHE_NUMBERS // ((16 if mueller else 4) * len(self.data))
+            chunk = min(n_sets, 1 << max(0, chunk.bit_length() - 1))
+            if chunk >= n_sets:
+                return pointwise(matrix).sum(axis=-1)
+            blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
+            return jax.lax.map(lambda block: pointwise(block).sum(axis=-1), blocks).reshape(n_sets)
+
+        return jax.jit(pointwise if which == 0 else total)
 
     def _logpdf(self, channel, resid, scale):
         if not self.robust:

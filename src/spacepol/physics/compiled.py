@@ -31,7 +31,9 @@ def degree_of_polarization(stokes):
     """|S_pol| / S0 (0 where S0 = 0), numpy or JAX arrays."""
     xp = jnp if isinstance(stokes, jax.Array) else np
     s0 = stokes[0]
-    pol = xp.sqrt(stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2)
+    pol2 = stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2
+    polarized = pol2 > 0  # sqrt kept off 0, where its derivative is infinite (unpolarized retro-reflection)
+    pol = xp.where(polarized, xp.sqrt(xp.where(polarized, pol2, 1.0)), 0.0)
     lit = s0 > 0
     # |S| <= S0 holds for every lobe; rounding may push a ratio an ulp above 1.
     return xp.where(lit, xp.minimum(pol / xp.where(lit, s0, 1.0), 1.0), 0.0)

@@ -1,0 +1,147 @@
+"""Experiment design: which further measurements would break a degeneracy the data leave.
+
+From a parameter point (the posterior median, or the optimum) the Fisher information of the data in hand
+(``infer.fisher``) plus the priors' precision gives the Laplace covariance of the free model parameters.
+In units of each prior's width its largest eigenvalue is the worst-measured combination: the *ridge*
+(for DOP alone, k_s and rho_d scaled together). Every candidate measurement (an observable at a geometry
+of a grid over the hemisphere, at an assumed noise) adds its own information; the candidates are ranked
+by how much they shrink the posterior sd along the ridge, picked greedily (each pick changes what the
+next one adds), and the result is said in words: "measure BRDF at theta_i 20, theta_r 0, dphi 180 ...
+shrinks the k_s-rho_d ridge 25x; DOP at any geometry at most 1.0x". The prediction is linear; whether
+the posterior really shrinks is measured by adding the measurements and inverting again
+(``tests/test_design.py``, ``benchmarks/design_shrink.py``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import observables as obs
+from ..infer import fisher
+from ..physics.geometry import Geometry
+
+# assumed noise of a candidate measurement when the data do not tell it: DOP and m_ij absolute, BRDF relative
+DEFAULT_NOISE = {"dop": 0.01, "brdf": 0.05, "mueller": 0.01}
+CANDIDATE_OBSERVABLES = ("dop", "brdf", "mueller")
+
+
+@dataclass
+class Candidate:
+    observable: str
+    theta_i: float
+    theta_r: float
+    dphi: float
+    noise: float
+
+    def describe(self) -> str:
+        what = {"dop": "DOP", "brdf": "BRDF", "mueller": "the Mueller matrix"}[self.observable]
+        return f"{what} at theta_i {self.theta_i:g}, theta_r {self.theta_r:g}, dphi {self.dphi:g} deg"
+
+
+def candidate_geometry(angles=tuple(range(10, 81, 10)), azimuths=(180.0, 0.0, 90.0)) -> Geometry:
+    """The grid candidates are drawn from: theta_i, theta_r over ``angles``, dphi over ``azimuths``
+    (180 = forward/specular plane, 0 = back towards the source, 90 = across)."""
+    ti, tr, dp = np.meshgrid(np.asarray(angles, float), np.asarray(angles, float), np.asarray(azimuths, float), indexing="ij")
+    return Geometry(ti.ravel(), tr.ravel(), dp.ravel())
+
+
+def _scale(likelihood, channel: str, point: dict) -> np.ndarray:
+    """The channel's noise per data row (N,) at one parameter point."""
+    scale = np.asarray(likelihood.scale(channel, {k: np.atleast_1d(np.asarray(v, float)) for k, v in point.items()}), float)
+    return np.broadcast_to(scale[0] if scale.ndim == 2 else scale, (len(likelihood.data),))
+
+
+def noise_levels(likelihood, point: dict) -> dict:
+    """The noise of each observable as the data have it (median file error, or the inferred level at
+    ``point``), else DEFAULT_NOISE; BRDF as a relative level."""
+    out = dict(DEFAULT_NOISE)
+    for o in likelihood.objects:
+        levels = []
+        for ch in o.channels:
+            scale = _scale(likelihood, ch, point)
+            if o.name == "brdf" and not likelihood.inferred(ch):  # absolute errors: as a relative level
+                scale = scale / np.maximum(np.abs(likelihood.observed()[ch]), 1e-300)
+            levels.append(float(np.median(scale)))
+        out[o.name] = float(np.median(levels))
+    return out
+
+
+def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = None, observables=CANDIDATE_OBSERVABLES,
+           noise: dict | None = None) -> dict:
+    """Rank candidate measurements by how much they shrink the worst-measured parameter combination.
+
+    ``point``: every parameter's value (model and noise), e.g. the posterior median. Returns a dict with
+    the ridge (its parameters, direction, sd relative to the prior before), the greedy picks with the
+    sd along the ridge after each, the best single measurement per observable and the findings in words."""
+    lik = posterior.likelihood
+    model, priors = lik.model, posterior.priors
+    model_names = {p.name for p in model.parameters}
+    names = [n for n in priors.names if n in model_names]
+    noise = {**noise_levels(lik, point), **(noise or {})}
+    values = {k: v for k, v in point.items() if k in model_names}
+    # the data in hand, each channel in its likelihood's residual space (BRDF in log when its noise is relative)
+    relative_brdf = "brdf" in lik.observables and lik.inferred("brdf")
+    channels, jac = fisher.jacobian(model, lik.geometry, lik.objects, values, names, relative_brdf=relative_brdf)
+    info = fisher.information(jac, np.concatenate([_scale(lik, ch, point) for ch in channels]))
+    prior_sd = 1.0 / np.sqrt(np.diag(fisher.prior_precision(priors, names)))
+    precision = info + fisher.prior_precision(priors, names)
+
+    def ridge_sd(prec, direction):  # posterior sd along ``direction`` (in prior-sd units)
+        scaled = np.linalg.inv(prec) / np.outer(prior_sd, prior_sd)
+        return float(np.sqrt(direction @ scaled @ direction))
+
+    scaled_cov = np.linalg.inv(precision) / np.outer(prior_sd, prior_sd)
+    eigenvalues, vectors = np.linalg.eigh(scaled_cov)
+    direction = vectors[:, -1]
+    involved = [n for n, c in zip(names, direction) if abs(c) >= 0.3]
+    before = ridge_sd(precision, direction)
+
+    grid = geometry if geometry is not None else candidate_geometry()
+    blocks = {}  # observable -> (candidates, per-candidate information matrices)
+    for name in observables:
+        o = obs.get(name)
+        cand_channels, cand_jac = fisher.jacobian(model, grid, [o], values, names)
+        n = grid.size
+        per = []
+        for j in range(n):
+            rows = cand_jac[[k * n + j for k in range(len(cand_channels))]]
+            rows = np.where(np.isfinite(rows), rows, 0.0)  # a number the model cannot differentiate there adds nothing
+            per.append(fisher.information(rows, np.full(len(rows), noise[name])))
+        blocks[name] = ([Candidate(name, float(grid.theta_i[j]), float(grid.theta_r[j]), float(grid.dphi[j]), noise[name])
+                         for j in range(n)], per)
+
+    best_single, single = {}, {}
+    for name, (cands, per) in blocks.items():
+        sds = [ridge_sd(precision + f, direction) for f in per]
+        j = int(np.argmin(sds))
+        best_single[name] = {"measurement": cands[j].describe(), "shrink": before / sds[j], "sd_after": sds[j]}
+        single[name] = [[c.theta_i, c.theta_r, c.dphi, before / sd] for c, sd in zip(cands, sds)]
+
+    chosen, current = [], precision.copy()
+    for _ in range(picks):
+        taken = {(c["observable"], c["theta_i"], c["theta_r"], c["dphi"]) for c in chosen}  # distinct geometries
+        options = [(ridge_sd(current + f, direction), name, j) for name, (cands, per) in blocks.items() for j, f in enumerate(per)
+                   if (name, cands[j].theta_i, cands[j].theta_r, cands[j].dphi) not in taken]
+        sd, name, j = min(options)
+        current = current + blocks[name][1][j]
+        chosen.append({"measurement": blocks[name][0][j].describe(), "observable": name,
+                       "theta_i": blocks[name][0][j].theta_i, "theta_r": blocks[name][0][j].theta_r,
+                       "dphi": blocks[name][0][j].dphi, "noise": noise[name], "sd_after": sd, "shrink": before / sd})
+    findings = [_words(involved, before, chosen, best_single, noise)]
+    return {"parameters": names, "point": {n: float(values[n]) for n in names}, "noise": noise,
+            "ridge": {"parameters": involved, "direction": {n: float(c) for n, c in zip(names, direction)},
+                      "sd_relative_to_prior": before},
+            "picks": chosen, "best_single": best_single, "single": single, "findings": findings}
+
+
+def _words(involved, before, chosen, best_single, noise) -> str:
+    what = ", ".join(involved)
+    picks = "; then ".join(f"{c['measurement']} ({c['shrink']:.1f}x)" for c in chosen)
+    singles = ", ".join(f"{name.upper() if name != 'mueller' else 'Mueller'} at best {s['shrink']:.2f}x"
+                        for name, s in best_single.items())
+    return (f"The worst-measured combination is along {what}: its posterior sd is {before:.2f} of the prior's "
+            f"(Laplace approximation at the point). To break it, measure {picks} (the factor is how much the sd "
+            f"along it shrinks, cumulative, at noise DOP {noise['dop']:g}, BRDF {100 * noise['brdf']:.0f} %, "
+            f"m_ij {noise['mueller']:g}). One measurement of each kind at its best geometry: {singles}.")

@@ -15,8 +15,8 @@
   pass ArviZ's rank-normalised split R-hat <= ``rhat_target`` and bulk/tail ESS >=
   ``ess_target`` (walkers as chains) on the kept draws.
 * Resuming: with ``backend_path`` the chain lives in an HDF5 file (emcee's HDFBackend, which
-  also stores the random state); a re-run continues it and gives the chain an uninterrupted
-  run would have given.
+  also stores the random state; written every 100 steps, ``buffered_backend``); a re-run continues it
+  and gives the chain an uninterrupted run would have given.
 * Randomness: emcee draws from a RandomState seeded from the Generator passed in.
 """
 
@@ -28,6 +28,7 @@ import time
 import emcee
 import numpy as np
 
+from ..buffered_backend import BufferedHDFBackend
 from ..result import Result
 
 
@@ -103,7 +104,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             # killed while emcee rewrote its random state: the steps are intact, so continue from them with a
             # state drawn from this run's generator (reproducible from --seed and the step count)
             replace_random_state(backend_path, np.random.RandomState(int(rng.integers(2**32)) ^ stored).get_state())
-        backend = emcee.backends.HDFBackend(str(backend_path), name="mcmc")
+        backend = BufferedHDFBackend(str(backend_path), name="mcmc")
         if stored > 0:
             if tuple(backend.shape) != (walkers, ndim):
                 from ...errors import SpacepolError
@@ -152,7 +153,11 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
 
     while sampler.iteration < max_steps:
         target = min(max_steps, (sampler.iteration // check_every + 1) * check_every)
-        state = sampler.run_mcmc(state, target - sampler.iteration, progress=False)
+        try:
+            state = sampler.run_mcmc(state, target - sampler.iteration, progress=False)
+        finally:  # interrupted too: the steps taken so far go to the file, so the same command continues them
+            if backend is not None:
+                backend.flush()
         tau = sampler.get_autocorr_time(tol=0)
         ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau

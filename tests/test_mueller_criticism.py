@@ -19,7 +19,8 @@ def _diagnose(kind, observables, candidates=TWINS):
                     observables=observables, candidates=candidates, top=2, progress=False, max_steps=6000)
 
 
-@pytest.mark.parametrize("kind", ["depolarization", "extinction"])
+# extinction's half of each pair is slow (the JAX model compiles per candidate: the default suite keeps one)
+@pytest.mark.parametrize("kind", ["depolarization", pytest.param("extinction", marks=pytest.mark.slow)])
 def test_the_full_mueller_matrix_separates_the_twins(kind):
     report = _diagnose(kind, ["mueller", "brdf"])
     lead = report["ranking"][0]
@@ -29,7 +30,7 @@ def test_the_full_mueller_matrix_separates_the_twins(kind):
     assert refit["delta_elpd"] is not None and lead["delta_elpd"] - refit["delta_elpd"] > 10
 
 
-@pytest.mark.parametrize("kind", ["depolarization", "extinction"])
+@pytest.mark.parametrize("kind", ["depolarization", pytest.param("extinction", marks=pytest.mark.slow)])
 def test_dop_and_brdf_of_the_same_data_leave_them_tied(kind):
     report = _diagnose(kind, ["dop", "brdf"])
     pair = {report["verdict"], *report["ranking"][0].get("tied_with", [])}
@@ -37,6 +38,7 @@ def test_dop_and_brdf_of_the_same_data_leave_them_tied(kind):
     assert "full Mueller matrix" in report["ranking"][0]["explanation"]
 
 
+@pytest.mark.slow  # 100 s; test_the_whole_library_on_full_mueller_sets covers subsurface and none too
 def test_a_hidden_subsurface_term_is_named_and_the_null_set_gets_none():
     report = _diagnose("subsurface", ["mueller", "brdf"], CANDIDATES)
     assert report["verdict"] in ("subsurface", "polarized_diffuse"), report["verdict"]

@@ -134,6 +134,7 @@ def swap_path(tmp_path_factory):
     return tmp, json.loads((tmp / "d.json").read_text()), run
 
 
+@pytest.mark.slow  # the --rounds 3 path costs 50 s; test_tutorial climbs a path of rounds in the default suite
 def test_rounds_replace_the_wrong_parts_until_the_residuals_are_noise(swap_path):
     tmp, report, run = swap_path
     rounds = report["rounds"]
@@ -148,6 +149,7 @@ def test_rounds_replace_the_wrong_parts_until_the_residuals_are_noise(swap_path)
     assert (tmp / "dg" / "path.png").stat().st_size > 0 and "round" in (tmp / "dg" / "report.html").read_text()
 
 
+@pytest.mark.slow
 def test_ladder_reads_the_path_to_replay(swap_path, tmp_path):
     """The replay's steps are the path's changes, in order; a path from another start model is refused
     before any fit (the full refit of the path is the slow test below)."""

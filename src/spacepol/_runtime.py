@@ -4,7 +4,7 @@ keeps freed memory.
 One BLAS thread unless the user says otherwise.
 
 spacepol's linear algebra is on matrices the size of the parameter vector (L-BFGS-B's updates,
-covariances), where BLAS threads cannot help; but they spin while numba's threads hold the cores,
+covariances), where BLAS threads cannot help; but they spin while the model's threads hold the cores,
 and each tiny call then waits for a time slice. Measured on this 2-core machine: L-BFGS-B polishing
 of the paper model 40x slower (0.3 s instead of 7 ms per start), one diagnose round 71 s -> 31 s.
 Set before numpy or scipy load BLAS (the environment variable); libraries already loaded are limited

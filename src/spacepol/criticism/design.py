@@ -141,6 +141,10 @@ def _words(involved, before, chosen, best_single, noise) -> str:
     picks = "; then ".join(f"{c['measurement']} ({c['shrink']:.1f}x)" for c in chosen)
     singles = ", ".join(f"{name.upper() if name != 'mueller' else 'Mueller'} at best {s['shrink']:.2f}x"
                         for name, s in best_single.items())
+    if before < 0.1:  # no degeneracy to break
+        return (f"No degeneracy: the worst-measured combination (along {what}) already has a posterior sd of "
+                f"{before:.3f} of the prior's (Laplace approximation at the point). The best further measurements "
+                f"({picks}) would narrow it little; one measurement of each kind at its best geometry: {singles}.")
     return (f"The worst-measured combination is along {what}: its posterior sd is {before:.2f} of the prior's "
             f"(Laplace approximation at the point). To break it, measure {picks} (the factor is how much the sd "
             f"along it shrinks, cumulative, at noise DOP {noise['dop']:g}, BRDF {100 * noise['brdf']:.0f} %, "

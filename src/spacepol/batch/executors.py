@@ -38,6 +38,17 @@ def _failed(job, exc) -> dict:
             "error": f"worker lost: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}".rstrip(": ")}
 
 
+def _collect(futures: dict, as_completed, on_done) -> None:
+    """``on_done`` for each job as it finishes; a worker that died with its set (BrokenProcessPool,
+    Dask's KilledWorker) fails that set only."""
+    for future in as_completed(futures):
+        try:
+            outcome = future.result()
+        except Exception as exc:
+            outcome = _failed(futures[future], exc)
+        on_done(outcome)
+
+
 def run_local(jobs, out: str, workers: int, on_done) -> None:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -45,13 +56,7 @@ def run_local(jobs, out: str, workers: int, on_done) -> None:
     with _worker_environment():
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
     try:
-        futures = {pool.submit(run_job, job, out): job for job in jobs}
-        for future in as_completed(futures):
-            try:
-                outcome = future.result()
-            except Exception as exc:  # BrokenProcessPool: the worker died with this set
-                outcome = _failed(futures[future], exc)
-            on_done(outcome)
+        _collect({pool.submit(run_job, job, out): job for job in jobs}, as_completed, on_done)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 
@@ -72,13 +77,8 @@ def run_dask(jobs, out: str, workers: int, scheduler: str | None, on_done) -> No
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
             client = Client(cluster)
     try:
-        futures = {client.submit(run_job, job, out, key=f"spacepol-batch-{job.id}", pure=False): job for job in jobs}
-        for future in as_completed(futures):
-            try:
-                outcome = future.result()
-            except Exception as exc:  # KilledWorker: the set took its worker down
-                outcome = _failed(futures[future], exc)
-            on_done(outcome)
+        _collect({client.submit(run_job, job, out, key=f"spacepol-batch-{job.id}", pure=False): job for job in jobs},
+                 as_completed, on_done)
     finally:
         client.close()
         if cluster is not None:

@@ -91,6 +91,8 @@ class Likelihood:
         self.labels = [f"{ch}[{i}] (theta_i {data.theta_i[i]:g}, theta_r {data.theta_r[i]:g}, dphi {data.dphi[i]:g} deg)"
                        for ch in self.observables for i in range(len(data))]
         self._jitted, self._program = {}, None  # compiled at the first call, per kind and parameter layout
+        # batch sizes a caller will use again and again (emcee's half-ensemble): compiled exactly, not padded
+        self.exact_sizes: set[int] = set()
 
     @property
     def batch_sets(self) -> int:
@@ -167,7 +169,8 @@ class Likelihood:
         if not n_sets:
             return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
         matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
-        rows = next((size for size in _BATCH_SIZES if size >= n_sets), _BATCH_SIZES[-1])
+        sizes = sorted(set(_BATCH_SIZES) | self.exact_sizes)
+        rows = next((size for size in sizes if size >= n_sets), sizes[-1])
         if n_sets > rows:  # in blocks of the largest size
             return np.concatenate([self._call(which, {**scalars, **{n: v[i : i + rows] for n, v in columns}})
                                    for i in range(0, n_sets, rows)], axis=0)
@@ -205,8 +208,8 @@ class Likelihood:
             # chunks of sets small enough that the sets x geometries intermediates stay in the CPU's cache:
             # above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2 at 64)
             n_sets = matrix.shape[0]
-            chunk = _CACHE_NUMBERS // ((16 if mueller else 4) * len(self.data))
-            chunk = min(n_sets, 1 << max(0, chunk.bit_length() - 1))
+            chunk = min(n_sets, max(1, _CACHE_NUMBERS // ((16 if mueller else 4) * len(self.data))))
+            chunk = next(c for c in range(chunk, 0, -1) if n_sets % c == 0)  # the largest that divides the batch
             if chunk >= n_sets:
                 return pointwise(matrix).sum(axis=-1)
             blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])

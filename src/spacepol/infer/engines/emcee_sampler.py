@@ -115,6 +115,10 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         else:
             backend.reset(walkers, ndim)
 
+    # every step evaluates half the ensemble: that size is compiled as it is (padding 18 walkers to the next
+    # compiled size, 64, tripled the cost of a full-Mueller step)
+    if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
+        posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
     sampler = emcee.EnsembleSampler(walkers, ndim, posterior.log_prob, vectorize=True, moves=_moves(), backend=backend)
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True
 

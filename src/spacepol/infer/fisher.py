@@ -31,7 +31,7 @@ def jacobian(model, geometry: Geometry, observables, point: dict, names: list[st
     def predict(theta):
         values = {**fixed, **{n: theta[j] for j, n in enumerate(names)}}
         total, dop = program(values, program.inputs)
-        prediction = Prediction(stokes=total[:, 0] if mueller else total, dop=dop, mueller=total if mueller else None)
+        prediction = Prediction.from_total(total, dop, mueller)
         blocks = []
         for o in observables:
             predicted = o.predict(prediction)

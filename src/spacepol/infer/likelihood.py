@@ -192,7 +192,7 @@ class Likelihood:
         def pointwise(matrix):
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
             total, dop = program({k: v for k, v in values.items() if k in model_names}, program.inputs)
-            prediction = Prediction(stokes=total[:, 0] if mueller else total, dop=dop, mueller=total if mueller else None)
+            prediction = Prediction.from_total(total, dop, mueller)
             predicted = {}
             for o in self.objects:
                 predicted.update(o.predict(prediction))

@@ -30,6 +30,12 @@ class Prediction:
     dop: np.ndarray  # measured DOP (after any estimator effect such as dop_bias)
     mueller: np.ndarray | None = None
 
+    @classmethod
+    def from_total(cls, total, dop, mueller: bool) -> "Prediction":
+        """From the model's total: a Mueller matrix (its first column is the Stokes vector for unpolarized
+        incidence) when ``mueller``, else the Stokes vector itself."""
+        return cls(stokes=total[:, 0] if mueller else total, dop=dop, mueller=total if mueller else None)
+
     @property
     def brdf(self):
         return self.stokes[0]
@@ -189,8 +195,7 @@ class Model:
         total, dop = np.asarray(total), np.asarray(dop)
         if n_sets:  # the padding off
             total, dop = total[..., :n_sets, :], dop[:n_sets]
-        stokes = total[:, 0] if mueller else total
-        return Prediction(stokes=stokes, dop=dop, mueller=total if mueller else None)
+        return Prediction.from_total(total, dop, mueller)
 
     @property
     def inner(self) -> "Model":

@@ -159,7 +159,4 @@ def _assemble(parts, size: int, mueller: bool) -> Prediction:
             out[..., idx] = get(pred)
         return out
 
-    if mueller:
-        total = gather(lambda p: p.mueller)
-        return Prediction(stokes=total[:, 0], dop=gather(lambda p: p.dop), mueller=total)
-    return Prediction(stokes=gather(lambda p: p.stokes), dop=gather(lambda p: p.dop))
+    return Prediction.from_total(gather(lambda p: p.mueller if mueller else p.stokes), gather(lambda p: p.dop), mueller)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 import sys
 import time
-from pathlib import Path
 
 from ..errors import ParameterError
 from ..io.output import check_output_dir, folder_lock

@@ -24,7 +24,7 @@ from scipy.special import gammaln
 from .. import observables as obs
 from ..errors import ParameterError
 from ..io.measurements import Dataset
-from ..observables.base import array_module
+from ..physics.arrays import array_module
 from ..physics.compiled import Program
 from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter

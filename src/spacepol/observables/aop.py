@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..infer.priors import LogUniform
+from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
-from .base import ColumnObservable, array_module
+from .base import ColumnObservable
 
 
 def wrap_deg(angle):

@@ -16,18 +16,13 @@ from __future__ import annotations
 
 import math
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
 
 _LOG_2PI = math.log(2 * math.pi)
-
-
-def array_module(*arrays):
-    """jax.numpy when any of ``arrays`` is a JAX array (inside the compiled likelihood), else numpy."""
-    return jnp if any(isinstance(a, jax.Array) for a in arrays) else np
 
 
 class Observable:

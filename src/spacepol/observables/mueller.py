@@ -12,8 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..infer.priors import LogUniform
+from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
-from .base import Observable, array_module
+from .base import Observable
 
 ELEMENTS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]
 GROUPS = {"pol": ("m12", "m13", "m14", "m21", "m31", "m41"), "lin": ("m22", "m23", "m32", "m33"),

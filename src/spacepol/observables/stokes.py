@@ -7,8 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..infer.priors import LogUniform
+from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
-from .base import Observable, array_module
+from .base import Observable
 
 
 def _normalised(stokes, row):

@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .arrays import array_module
 from .builtin_effects import Specular
 from .effect import Context, DepolarizedLobe
 from .geometry import Geometry
@@ -29,7 +30,7 @@ _JITTED: dict = {}
 
 def degree_of_polarization(stokes):
     """|S_pol| / S0 (0 where S0 = 0), numpy or JAX arrays."""
-    xp = jnp if isinstance(stokes, jax.Array) else np
+    xp = array_module(stokes)
     s0 = stokes[0]
     pol2 = stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2
     polarized = pol2 > 0  # sqrt kept off 0, where its derivative is infinite (unpolarized retro-reflection)

@@ -21,9 +21,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import jax
 import jax.numpy as jnp
 import numpy as np
+
+from .arrays import array_module
 
 _TINY = 1e-12
 
@@ -51,7 +52,7 @@ class Geometry:
 
     def __post_init__(self):
         angles = (self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
-        xp = jnp if any(isinstance(a, jax.Array) for a in angles) else np
+        xp = array_module(*angles)
         self.xp = xp
         ti, tr, dp = xp.broadcast_arrays(*(xp.asarray(a, dtype=float) for a in angles[:3]))
         self.theta_i, self.theta_r, self.dphi = ti, tr, dp

@@ -8,11 +8,11 @@ from __future__ import annotations
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
 from ..errors import ParameterError, SpacepolError, UnknownNameError
+from .arrays import array_module
 from .compiled import degree_of_polarization, evaluate_values, jitted, padded
 from .effect import Effect
 from .geometry import Geometry
@@ -47,7 +47,7 @@ class Prediction:
     @property
     def aop_deg(self):
         """Angle of polarization from the s direction towards p, degrees in (-90, 90]."""
-        xp = jnp if isinstance(self.stokes, jax.Array) else np
+        xp = array_module(self.stokes)
         return 0.5 * xp.degrees(xp.arctan2(self.stokes[2], self.stokes[1]))
 
 

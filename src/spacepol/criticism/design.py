@@ -85,16 +85,17 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
     relative_brdf = "brdf" in lik.observables and lik.inferred("brdf")
     channels, jac = fisher.jacobian(model, lik.geometry, lik.objects, values, names, relative_brdf=relative_brdf)
     info = fisher.information(jac, np.concatenate([_scale(lik, ch, point) for ch in channels]))
-    prior_sd = 1.0 / np.sqrt(np.diag(fisher.prior_precision(priors, names)))
-    precision = info + fisher.prior_precision(priors, names)
+    prior = fisher.prior_precision(priors, names)
+    prior_sd = 1.0 / np.sqrt(np.diag(prior))
+    precision = info + prior
+
+    def scaled_covariance(prec):  # the Laplace covariance in units of each prior's sd
+        return np.linalg.inv(prec) / np.outer(prior_sd, prior_sd)
 
     def ridge_sd(prec, direction):  # posterior sd along ``direction`` (in prior-sd units)
-        scaled = np.linalg.inv(prec) / np.outer(prior_sd, prior_sd)
-        return float(np.sqrt(direction @ scaled @ direction))
+        return float(np.sqrt(direction @ scaled_covariance(prec) @ direction))
 
-    scaled_cov = np.linalg.inv(precision) / np.outer(prior_sd, prior_sd)
-    eigenvalues, vectors = np.linalg.eigh(scaled_cov)
-    direction = vectors[:, -1]
+    direction = np.linalg.eigh(scaled_covariance(precision))[1][:, -1]  # the largest eigenvalue's vector
     involved = [n for n, c in zip(names, direction) if abs(c) >= 0.3]
     before = ridge_sd(precision, direction)
 
@@ -126,9 +127,9 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
                    if (name, cands[j].theta_i, cands[j].theta_r, cands[j].dphi) not in taken]
         sd, name, j = min(options)
         current = current + blocks[name][1][j]
-        chosen.append({"measurement": blocks[name][0][j].describe(), "observable": name,
-                       "theta_i": blocks[name][0][j].theta_i, "theta_r": blocks[name][0][j].theta_r,
-                       "dphi": blocks[name][0][j].dphi, "noise": noise[name], "sd_after": sd, "shrink": before / sd})
+        pick = blocks[name][0][j]
+        chosen.append({"measurement": pick.describe(), "observable": name, "theta_i": pick.theta_i, "theta_r": pick.theta_r,
+                       "dphi": pick.dphi, "noise": pick.noise, "sd_after": sd, "shrink": before / sd})
     findings = [_words(involved, before, chosen, best_single, noise)]
     return {"parameters": names, "point": {n: float(values[n]) for n in names}, "noise": noise,
             "ridge": {"parameters": involved, "direction": {n: float(c) for n, c in zip(names, direction)},

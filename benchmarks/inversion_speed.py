@@ -1,71 +1,135 @@
-"""Time to a converged posterior: an 84-point DOP set, the `paper` model, emcee, in one process.
+"""Time and ESS per second to a converged posterior, engines side by side, in one process.
 
-Converged means the sampler's own stopping rule: chain longer than 50 integrated
-autocorrelation times, R-hat <= 1.01 and ESS >= 400 for every parameter (walkers as chains).
-Prints the wall time (median over seeds), ESS per second, and the paper's GA run on the same
-data: wall time, evaluations and its eq-25 objective, side by side.
+Sets: an 84-point synthetic DOP set (the k_s/rho_d ridge: DOP sees only their ratio), the bundled
+84-point set `data/synthetic/hidden_effect.csv` (DOP and BRDF), and with ``--ptfe`` the PTFE full-Mueller
+set at 0.633 um (the Mueller matrix and the BRDF, the CLI's default observables). Model `paper` (PTFE: paper+polarized_diffuse).
 
-    python benchmarks/inversion_speed.py [--seeds 3]
+Engines, each to the same stopping rule (ArviZ rank-normalised split R-hat <= 1.01 and bulk/tail ESS >= 400):
+* emcee in the declared parameters (the baseline: what spacepol did before the logit space),
+* emcee in the logit of each prior's CDF (the default; ``infer.sampling_space``), emcee also needing
+  50 integrated autocorrelation times,
+* NUTS (numpyro, dense mass matrix, 4 chains vectorised) in the same logit space; its first run includes
+  JAX compilation (printed apart), the seeds after it reuse the compiled sampler.
+Times are whole ``invert`` calls for emcee (optimum, sampling, ArviZ, LOO, checks) and the sampler alone for
+NUTS, so the NUTS figures flatter it slightly. Plus the paper's GA on the 84-point set (a point, no uncertainty).
+
+    python benchmarks/inversion_speed.py [--seeds 3] [--ptfe]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 
 import numpy as np
 
-from spacepol.infer.engines import optimize
-from spacepol.infer.inversion import invert
-from spacepol.infer.objective import PaperObjective
-from spacepol.infer.posterior import Posterior
-from spacepol.infer.prior_set import PriorSet
-from spacepol.io.measurements import Dataset
-from spacepol.physics import Model
-from spacepol.physics.geometry import default_grid
+from spacepol._runtime import configure_jax
+
+configure_jax()
+
+from spacepol.infer.engines import optimize  # noqa: E402
+from spacepol.infer.engines.nuts import sample_nuts  # noqa: E402
+from spacepol.infer.inversion import invert  # noqa: E402
+from spacepol.infer.objective import PaperObjective  # noqa: E402
+from spacepol.infer.posterior import Posterior  # noqa: E402
+from spacepol.infer.prior_set import PriorSet  # noqa: E402
+from spacepol.infer.sampling_space import DeclaredSpace  # noqa: E402
+from spacepol.io.measurements import Dataset, read_measurements  # noqa: E402
+from spacepol.paths import bundled  # noqa: E402
+from spacepol.physics import Model  # noqa: E402
+from spacepol.physics.geometry import default_grid  # noqa: E402
 
 TRUTH = {"n": 1.24, "k": 6.6, "sigma": 0.2, "ks": 0.5, "rho_d": 0.1}
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--seeds", type=int, default=3)
-    args = parser.parse_args()
+def dop_set():
     model = Model.from_string("paper")
     g = default_grid()
     rng = np.random.default_rng(0)
     data = Dataset(g.theta_i, g.theta_r, g.dphi)
     data.dop = np.clip(model.evaluate(TRUTH, data.geometry).dop + 0.005 * rng.standard_normal(g.size), 0, 1)
     data.dop_err = np.full(g.size, 0.005)
-    posterior = Posterior.build(data, model)
-    invert(posterior, seed=99, max_steps=200, progress=False)  # warm-up: compile kernels, import ArviZ
+    data.source = "synthetic 84-point DOP"
+    return Posterior.build(data, model)
 
-    walls, ess_rates, rows = [], [], []
-    for seed in range(args.seeds):
-        t0 = time.perf_counter()
-        inv = invert(posterior, seed=seed, progress=False)
-        wall = time.perf_counter() - t0
-        d = inv.summary["diagnostics"]
-        walls.append(wall)
-        ess_rates.append(d["ess_min"] / wall)
-        rows.append(f"  seed {seed}: {wall:6.1f} s, {inv.result.info['steps']} steps x {inv.result.info['walkers']} walkers, "
-                    f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, capped {inv.result.info['capped']}")
-    ga_walls, ga_evals, ga_obj = [], [], []
+
+def bundled_set():
+    data = read_measurements(bundled("synthetic", "hidden_effect.csv"))
+    return Posterior.build(data, Model.from_string("paper"))
+
+
+def ptfe_set():
+    data = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
+    return Posterior.build(data, Model.from_string("paper+polarized_diffuse"))  # the Mueller matrix and the BRDF
+
+
+def run_emcee(posterior, seed, space):
+    t0 = time.perf_counter()
+    inv = invert(posterior, seed=seed, progress=False, space=space)
+    wall = time.perf_counter() - t0
+    d, info = inv.summary["diagnostics"], inv.result.info
+    return wall, d["ess_min"], d["rhat_max"], f"{info['steps']} steps x {info['walkers']} walkers, tau_max {info['tau_max']:.0f}", info["capped"]
+
+
+def run_nuts(posterior, seed):
+    from spacepol.infer.diagnostics import convergence
+    from spacepol.infer.inference_data import to_inference_data
+
+    t0 = time.perf_counter()
+    res = sample_nuts(posterior, np.random.default_rng(seed), progress=False, seed=seed)
+    wall = time.perf_counter() - t0
+    d = convergence(to_inference_data(res, posterior, np.random.default_rng(seed)), res)
+    info = res.info
+    return wall, d["ess_min"], d["rhat_max"], (f"{info['steps']} draws x {info['chains']} chains, "
+                                               f"{info['leapfrog_per_draw']:.1f} leapfrog/draw, {info['divergences']} divergent"), info["capped"]
+
+
+def compare(label, posterior, seeds):
+    print(f"\n{label}: {posterior.likelihood.n_obs} numbers, {posterior.ndim} parameters ({', '.join(posterior.names)})")
+    invert(posterior, seed=99, max_steps=200, progress=False)  # warm-up: compile the likelihood, import ArviZ
+    t0 = time.perf_counter()
+    sample_nuts(posterior, np.random.default_rng(99), warmup=50, draws=50, max_draws=50, progress=False)
+    print(f"  NUTS first call (tracing + compilation, 50+50 draws): {time.perf_counter() - t0:.1f} s")
+    rows = {}
+    for engine, fn in (("emcee, declared parameters", lambda s: run_emcee(posterior, s, DeclaredSpace(posterior.priors))),
+                       ("emcee, logit-CDF space", lambda s: run_emcee(posterior, s, None)),
+                       ("NUTS, logit-CDF space", lambda s: run_nuts(posterior, s))):
+        walls, rates = [], []
+        for seed in range(seeds):
+            wall, ess, rhat, what, capped = fn(seed)
+            walls.append(wall)
+            rates.append(ess / wall)
+            print(f"  {engine:28s} seed {seed}: {wall:6.1f} s, {what}, R-hat {rhat:.4f}, ESS {ess:.0f}"
+                  f"{', CAPPED' if capped else ''}")
+        rows[engine] = (statistics.median(walls), statistics.median(rates))
+    base = rows["emcee, declared parameters"]
+    for engine, (wall, rate) in rows.items():
+        print(f"  -> {engine:28s} median {wall:6.1f} s, ESS/s {rate:7.0f} ({base[0] / wall:4.1f}x faster than the baseline)")
+    return rows
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seeds", type=int, default=3)
+    parser.add_argument("--ptfe", action="store_true", help="also the PTFE full-Mueller set (minutes)")
+    args = parser.parse_args()
+    print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores)")
+    posterior = dop_set()
+    compare("84-point synthetic DOP set (noise 0.005)", posterior, args.seeds)
+    compare("bundled 84-point set data/synthetic/hidden_effect.csv (DOP + BRDF), model paper", bundled_set(), args.seeds)
+    if args.ptfe:
+        compare("PTFE 0.633 um, full Mueller + BRDF, paper+polarized_diffuse", ptfe_set(), args.seeds)
+
+    data, model = posterior.likelihood.data, posterior.likelihood.model
     objective = PaperObjective(data, model, PriorSet(model.parameters))
-    for seed in range(args.seeds):
-        res = optimize("ga", objective, np.random.default_rng(seed), model.name)
-        ga_walls.append(res.seconds)
-        ga_evals.append(res.n_evaluations)
-        ga_obj.append(res.objective)
+    ga = [optimize("ga", objective, np.random.default_rng(seed), model.name) for seed in range(args.seeds)]
     truth_obj = float(objective(np.array([[TRUTH[n] for n in objective.names]]))[0])
-    print(f"paper model, {g.size}-point DOP set (noise 0.005), {args.seeds} seeds")
-    print("\n".join(rows))
-    print(f"emcee to a converged posterior: median {statistics.median(walls):.1f} s wall "
-          f"(target <= 15 s); ESS (min over parameters) per second: median {statistics.median(ess_rates):.0f}")
-    print(f"paper's GA: median {statistics.median(ga_walls):.2f} s wall, {statistics.median(ga_evals):.0f} evaluations, "
-          f"eq-25 objective median {statistics.median(ga_obj):.5f} (the truth scores {truth_obj:.5f}); "
-          f"a point, no uncertainty")
+    print(f"\npaper's GA on the DOP set: median {statistics.median(r.seconds for r in ga):.2f} s wall, "
+          f"{statistics.median(r.n_evaluations for r in ga):.0f} evaluations, eq-25 objective median "
+          f"{statistics.median(r.objective for r in ga):.5f} (the truth scores {truth_obj:.5f}); a point, no uncertainty")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

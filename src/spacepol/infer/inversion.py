@@ -18,6 +18,7 @@ from .identifiability import identifiability
 from .inference_data import to_inference_data
 from .posterior import Posterior
 from .result import Result
+from .sampling_space import SamplingSpace
 
 
 @dataclass
@@ -30,7 +31,7 @@ class Inversion:
     identifiability: dict
 
 
-def fingerprint(posterior: Posterior, walkers: int, seed: int) -> str:
+def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.name) -> str:
     lik = posterior.likelihood
     h = hashlib.sha256()
     h.update(lik.model.name.encode())
@@ -40,7 +41,7 @@ def fingerprint(posterior: Posterior, walkers: int, seed: int) -> str:
     observed = lik.observed()
     for o in lik.observables:
         h.update(np.ascontiguousarray(observed[o]).tobytes())
-    h.update(f"{walkers}:{seed}".encode())
+    h.update(f"{walkers}:{seed}:{space}".encode())  # the chain file holds the sampler's coordinates
     return h.hexdigest()[:16]
 
 
@@ -74,20 +75,21 @@ def check_walkers(walkers: int | None, ndim: int) -> int:
 
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
-           backend_path=None, progress: bool = True, check_every: int = 500, centre=None) -> Inversion:
+           backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None) -> Inversion:
     """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
-    around which the walkers start; by default a global optimisation finds one."""
+    around which the walkers start; by default a global optimisation finds one. ``space``: where the walkers
+    move (``sampling_space``; default the logit of each prior's CDF)."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = check_walkers(walkers, posterior.ndim)
     if backend_path is not None:
         backend_path = Path(backend_path)
-        print_ = fingerprint(posterior, walkers, seed)
+        print_ = fingerprint(posterior, walkers, seed, (space or SamplingSpace).name)
         _check_backend(backend_path, print_)
         _stamp_backend(backend_path, print_)  # before sampling, so an interrupted chain is recognised
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
-                          check_every=check_every,
+                          check_every=check_every, space=space,
                           initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
     if backend_path is not None:
         compact(backend_path)

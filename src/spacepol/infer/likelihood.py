@@ -179,6 +179,12 @@ class Likelihood:
         return np.asarray(self._jitted[key](matrix))[:n_sets]
 
     def _compile(self, which: int, names: tuple, scalars: tuple):
+        return jax.jit(self.function(which, names, scalars))
+
+    def function(self, which: int, names: tuple, scalars: tuple):
+        """The pure JAX function (not compiled) of a (P, len(names)) parameter matrix: the pointwise
+        log-likelihood (``which`` 0) or its sum per set (1); ``scalars``: ((name, value), ...) held fixed.
+        Gradient samplers and optimizers compose it with their own transforms and differentiate it."""
         if self._program is None:
             self._program = Program(self.model, self.geometry, self.needs_mueller)
         program, fixed = self._program, dict(scalars)
@@ -215,7 +221,7 @@ class Likelihood:
             blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
             return jax.lax.map(lambda block: pointwise(block).sum(axis=-1), blocks).reshape(n_sets)
 
-        return jax.jit(pointwise if which == 0 else total)
+        return pointwise if which == 0 else total
 
     def _logpdf(self, channel, resid, scale):
         if not self.robust:

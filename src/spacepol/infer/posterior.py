@@ -64,16 +64,23 @@ class Posterior:
         """log posterior (up to a constant) for each row of theta (W, D); -inf outside the priors."""
         theta = np.atleast_2d(theta)
         lp = self.priors.ln_prob(theta)
-        inside = np.isfinite(lp)
+        return lp + self.log_likelihood(theta, np.isfinite(lp))
+
+    def log_likelihood(self, theta, inside=None) -> np.ndarray:
+        """log-likelihood for each row of theta (W, D) (0 for a prior-only posterior); -inf where it is not
+        finite and in the rows not ``inside`` (a boolean mask; default every row)."""
+        theta = np.atleast_2d(theta)
+        inside = np.ones(len(theta), bool) if inside is None else inside
         if self.prior_only:
-            return lp
+            return np.where(inside, 0.0, -np.inf)
+        out = np.full(len(theta), -np.inf)
         if np.any(inside):
             # every row is evaluated (those outside the priors are discarded after): a fixed batch size is
             # one compiled program, where the varying count of rows inside would compile one per size
             ll = self.likelihood.total(self.priors.to_params(theta))[inside]
             self.n_evaluations += int(inside.sum())
-            lp[inside] += np.where(np.isfinite(ll), ll, -np.inf)
-        return lp
+            out[inside] = np.where(np.isfinite(ll), ll, -np.inf)
+        return out
 
     def __call__(self, theta):
         return self.log_prob(theta)

@@ -1,13 +1,16 @@
 """Priors as objects (bilby style): ``ln_prob``, ``sample`` and ``rescale`` from the unit cube.
 
 ``rescale`` lets the GA, nlopt and differential evolution search the very cube the sampler
-sees: a point ``u`` in [0, 1]^d maps to parameter values through each prior's inverse CDF.
+sees: a point ``u`` in [0, 1]^d maps to parameter values through each prior's inverse CDF; ``cdf`` is
+its exact inverse. ``rescale`` also takes JAX arrays (the gradient samplers trace it).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import jax
+import jax.scipy.special
 import numpy as np
 from scipy import special
 
@@ -24,7 +27,11 @@ class Prior:
         raise NotImplementedError
 
     def rescale(self, u):
-        """Inverse CDF: maps u in [0, 1] to a parameter value."""
+        """Inverse CDF: maps u in [0, 1] to a parameter value (numpy or JAX arrays)."""
+        raise NotImplementedError
+
+    def cdf(self, x):
+        """The CDF, the inverse of ``rescale`` on [lower, upper] (numpy)."""
         raise NotImplementedError
 
     def sample(self, rng: np.random.Generator, size=None):
@@ -37,6 +44,11 @@ class Prior:
     @property
     def is_fixed(self) -> bool:
         return False
+
+
+def _array(u):
+    """u as a float array of its own kind (a traced JAX value stays one)."""
+    return u if isinstance(u, jax.Array) else np.asarray(u, dtype=float)
 
 
 def _check_interval(lower: float, upper: float, what: str) -> None:
@@ -60,7 +72,10 @@ class Uniform(Prior):
         return np.where(inside, -np.log(self.upper - self.lower), -np.inf)
 
     def rescale(self, u):
-        return self.lower + (self.upper - self.lower) * np.asarray(u, dtype=float)
+        return self.lower + (self.upper - self.lower) * _array(u)
+
+    def cdf(self, x):
+        return np.clip((np.asarray(x, dtype=float) - self.lower) / (self.upper - self.lower), 0.0, 1.0)
 
     def __str__(self):
         return f"Uniform({self.lower:g}, {self.upper:g})"
@@ -86,7 +101,11 @@ class LogUniform(Prior):
         return np.where(inside, value, -np.inf)
 
     def rescale(self, u):
-        return self.lower * (self.upper / self.lower) ** np.asarray(u, dtype=float)
+        return self.lower * (self.upper / self.lower) ** _array(u)
+
+    def cdf(self, x):
+        x = np.clip(np.asarray(x, dtype=float), self.lower, self.upper)
+        return np.log(x / self.lower) / np.log(self.upper / self.lower)
 
     def __str__(self):
         return f"LogUniform({self.lower:g}, {self.upper:g})"
@@ -127,7 +146,14 @@ class TruncatedNormal(Prior):
 
     def rescale(self, u):
         lo, hi = self._cdf_bounds()
-        return self.mu + self.sigma * special.ndtri(lo + (hi - lo) * np.asarray(u, dtype=float))
+        u = _array(u)
+        ndtri = jax.scipy.special.ndtri if isinstance(u, jax.Array) else special.ndtri
+        return self.mu + self.sigma * ndtri(lo + (hi - lo) * u)
+
+    def cdf(self, x):
+        lo, hi = self._cdf_bounds()
+        x = np.clip(np.asarray(x, dtype=float), self.lower, self.upper)
+        return np.clip((special.ndtr((x - self.mu) / self.sigma) - lo) / (hi - lo), 0.0, 1.0)
 
     def __str__(self):
         return f"TruncatedNormal({self.mu:g}, {self.sigma:g}, [{self.lower:g}, {self.upper:g}])"
@@ -161,6 +187,9 @@ class Fixed(Prior):
 
     def rescale(self, u):
         return np.full_like(np.asarray(u, dtype=float), self.value)
+
+    def cdf(self, x):
+        return np.where(np.asarray(x, dtype=float) >= self.value, 1.0, 0.0)
 
     def __str__(self):
         return f"Fixed({self.value:g})"

@@ -3,10 +3,13 @@
 * Walkers start in a small ball around a quick differential-evolution optimum of the log
   posterior (inside the prior support), not scattered over the prior (``initial="prior"``
   does that, or pass an array).
-* Moves: differential evolution: DE moves follow the long ridges that DOP-only data leave
-  (k_s against rho_d).  On an 84-point DOP set with the paper model DE gave tau ~ 90 steps
-  against ~ 200 for the stretch move; adding 20 % DE snooker cut tau to ~ 70 but emcee's
-  snooker proposal costs 4x a DE step in Python, so per second DE alone wins.
+* Space: the walkers move in the logit of each prior's CDF (``infer.sampling_space``), where the
+  declared priors are kept exactly and the wedge DOP leaves between k_s and rho_d is a straight band;
+  the chain file holds those coordinates, the Result the declared parameters. On the 84-point DOP set
+  tau fell from 50-76 to ~30 steps (``benchmarks/inversion_speed.py``).
+* Moves: differential evolution (80 %) and DE snooker (20 %): DE moves follow the long ridges that
+  DOP-only data leave (k_s against rho_d). In the logit space the stretch move needed tau ~ 80, DE
+  alone ~ 40, DE + snooker ~ 30 at 1.4x DE's cost per step: about equal per second.
 * Length: the chain grows in blocks of ``check_every`` steps (at absolute multiples, so a
   resumed run makes the same decisions) until it is longer than ``tau_multiple`` times the
   largest integrated autocorrelation time and that estimate has settled (changed < 5 % over
@@ -30,6 +33,7 @@ import numpy as np
 
 from ..buffered_backend import BufferedHDFBackend
 from ..result import Result
+from ..sampling_space import SamplingSpace
 
 
 def default_walkers(ndim: int) -> int:
@@ -60,9 +64,20 @@ def ball(posterior, centre, walkers, rng):
 
 
 def _kept(sampler, tau):
+    if not np.all(np.isfinite(tau)):  # not measurable yet (a walker that never moved): keep the second half
+        return sampler.iteration // 2, 1
     burn = int(min(sampler.iteration // 2, np.ceil(3 * np.max(tau))))
     thin = max(1, int(0.5 * np.min(tau)))
     return burn, thin
+
+
+def _tau(chain) -> np.ndarray:
+    """emcee's integrated autocorrelation time over the walkers that moved; inf while a walker has not
+    moved at all (its autocorrelation is 0/0, which would make the estimate NaN)."""
+    moved = np.all(np.ptp(chain, axis=0) > 0, axis=1)
+    if not moved.all():
+        return np.full(chain.shape[2], np.inf)
+    return emcee.autocorr.integrated_time(chain, tol=0)
 
 
 def _rhat_ess(sampler, tau):
@@ -83,14 +98,15 @@ def _moves():
 def _tau_at(sampler, iteration: int) -> np.ndarray:
     """The integrated autocorrelation time of the first ``iteration`` steps (what an uninterrupted run
     computed when it stood there), so a resumed run takes the same decisions."""
-    chain = sampler.get_chain()[:iteration]
-    return emcee.autocorr.integrated_time(chain, tol=0)
+    return _tau(sampler.get_chain()[:iteration])
 
 
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
                  tau_multiple: float = 50.0, check_every: int = 500, min_steps: int = 1000,
                  backend_path=None, progress: bool = True, model_name: str = "", seed: int | None = None,
-                 initial=None, rhat_target: float = 1.01, ess_target: float = 400.0) -> Result:
+                 initial=None, rhat_target: float = 1.01, ess_target: float = 400.0, space=None) -> Result:
+    """``space``: the coordinates the walkers move in (default ``SamplingSpace``, the logit of each prior's CDF;
+    ``DeclaredSpace`` is the declared parameters, the baseline of ``benchmarks/inversion_speed.py``)."""
     from ..chain_file import chain_iterations, random_state_readable, replace_random_state
 
     start = time.perf_counter()
@@ -119,11 +135,14 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     # compiled size, 64, tripled the cost of a full-Mueller step)
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
-    sampler = emcee.EnsembleSampler(walkers, ndim, posterior.log_prob, vectorize=True, moves=_moves(), backend=backend)
+    space = space or SamplingSpace(posterior.priors)
+    sampler = emcee.EnsembleSampler(walkers, ndim, space.log_prob(posterior), vectorize=True, moves=_moves(),
+                                    backend=backend)
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True
 
     def converged(tau, previous_tau):
-        settled = previous_tau is not None and np.all(np.abs(previous_tau - tau) < 0.05 * tau)
+        settled = (previous_tau is not None and np.all(np.isfinite(tau)) and np.all(np.isfinite(previous_tau))
+                   and np.all(np.abs(previous_tau - tau) < 0.05 * tau))
         long_enough = sampler.iteration >= max(min_steps, tau_multiple * np.max(tau)) and settled
         rhat, ess = (_rhat_ess(sampler, tau) if long_enough else (np.nan, np.nan))
         return long_enough and rhat <= rhat_target and ess >= ess_target, long_enough, rhat, ess
@@ -153,7 +172,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             initial = initial_ball(posterior, rng, walkers)
         elif isinstance(initial, str) and initial == "prior":
             initial = posterior.priors.sample(rng, walkers)
-        state = initial
+        state = space.to_z(initial)
 
     while sampler.iteration < max_steps:
         target = min(max_steps, (sampler.iteration // check_every + 1) * check_every)
@@ -162,7 +181,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         finally:  # interrupted too: the steps taken so far go to the file, so the same command continues them
             if backend is not None:
                 backend.flush()
-        tau = sampler.get_autocorr_time(tol=0)
+        tau = _tau(sampler.get_chain())
         ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau
         if progress:
@@ -178,15 +197,16 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
 
     tau_max = float(np.max(tau))
     burn, thin = _kept(sampler, tau)
-    chain = sampler.get_chain(discard=burn, thin=thin)
-    log_prob = sampler.get_log_prob(discard=burn, thin=thin)
+    chain_z = sampler.get_chain(discard=burn, thin=thin)
+    log_prob = space.log_posterior_theta(chain_z, sampler.get_log_prob(discard=burn, thin=thin))
+    chain = space.to_theta(chain_z.reshape(-1, ndim)).reshape(chain_z.shape)
     flat_i = np.unravel_index(np.argmax(log_prob), log_prob.shape)
     best = chain[flat_i]
     info = {
         "steps": int(sampler.iteration), "walkers": walkers, "burn_in": burn, "thin": thin,
         "tau": [float(t) for t in tau], "tau_max": tau_max,
         "acceptance": float(np.mean(sampler.acceptance_fraction)), "capped": capped,
-        "resumed": resumed, "moves": "DE",
+        "resumed": resumed, "moves": "DE", "space": space.name,
     }
     return Result(
         method="emcee", model=model_name, names=list(posterior.names),

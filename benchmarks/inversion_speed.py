@@ -1,7 +1,7 @@
 """Time and ESS per second to a converged posterior, engines side by side, in one process.
 
 Sets: an 84-point synthetic DOP set (the k_s/rho_d ridge: DOP sees only their ratio), the bundled
-84-point set `data/synthetic/hidden_effect.csv` (DOP and BRDF), and with ``--ptfe`` the PTFE full-Mueller
+84-point set `data/synthetic/hidden_effect.csv` (DOP and BRDF), and with ``--sets ... ptfe`` the PTFE full-Mueller
 set at 0.633 um (the Mueller matrix and the BRDF, the CLI's default observables). Model `paper` (PTFE: paper+polarized_diffuse).
 
 Engines, each to the same stopping rule (ArviZ rank-normalised split R-hat <= 1.01 and bulk/tail ESS >= 400):
@@ -13,7 +13,7 @@ Engines, each to the same stopping rule (ArviZ rank-normalised split R-hat <= 1.
 Times are whole ``invert`` calls for emcee (optimum, sampling, ArviZ, LOO, checks) and the sampler alone for
 NUTS, so the NUTS figures flatter it slightly. Plus the paper's GA on the 84-point set (a point, no uncertainty).
 
-    python benchmarks/inversion_speed.py [--seeds 3] [--ptfe]
+    python benchmarks/inversion_speed.py [--seeds 3] [--sets dop bundled ptfe]
 """
 
 from __future__ import annotations
@@ -73,12 +73,12 @@ def run_emcee(posterior, seed, space):
     return wall, d["ess_min"], d["rhat_max"], f"{info['steps']} steps x {info['walkers']} walkers, tau_max {info['tau_max']:.0f}", info["capped"]
 
 
-def run_nuts(posterior, seed):
+def run_nuts(posterior, seed, **options):
     from spacepol.infer.diagnostics import convergence
     from spacepol.infer.inference_data import to_inference_data
 
     t0 = time.perf_counter()
-    res = sample_nuts(posterior, np.random.default_rng(seed), progress=False, seed=seed)
+    res = sample_nuts(posterior, np.random.default_rng(seed), progress=False, seed=seed, **options)
     wall = time.perf_counter() - t0
     d = convergence(to_inference_data(res, posterior, np.random.default_rng(seed)), res)
     info = res.info
@@ -86,7 +86,7 @@ def run_nuts(posterior, seed):
                                                f"{info['leapfrog_per_draw']:.1f} leapfrog/draw, {info['divergences']} divergent"), info["capped"]
 
 
-def compare(label, posterior, seeds):
+def compare(label, posterior, seeds, nuts_options=None):
     print(f"\n{label}: {posterior.likelihood.n_obs} numbers, {posterior.ndim} parameters ({', '.join(posterior.names)})")
     invert(posterior, seed=99, max_steps=200, progress=False)  # warm-up: compile the likelihood, import ArviZ
     t0 = time.perf_counter()
@@ -95,7 +95,7 @@ def compare(label, posterior, seeds):
     rows = {}
     for engine, fn in (("emcee, declared parameters", lambda s: run_emcee(posterior, s, DeclaredSpace(posterior.priors))),
                        ("emcee, logit-CDF space", lambda s: run_emcee(posterior, s, None)),
-                       ("NUTS, logit-CDF space", lambda s: run_nuts(posterior, s))):
+                       ("NUTS, logit-CDF space", lambda s: run_nuts(posterior, s, **(nuts_options or {})))):
         walls, rates = [], []
         for seed in range(seeds):
             wall, ess, rhat, what, capped = fn(seed)
@@ -113,15 +113,21 @@ def compare(label, posterior, seeds):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--seeds", type=int, default=3)
-    parser.add_argument("--ptfe", action="store_true", help="also the PTFE full-Mueller set (minutes)")
+    parser.add_argument("--sets", nargs="+", choices=["dop", "bundled", "ptfe"], default=["dop", "bundled"],
+                        help="ptfe: the PTFE full-Mueller set (minutes per engine)")
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores)")
-    posterior = dop_set()
-    compare("84-point synthetic DOP set (noise 0.005)", posterior, args.seeds)
-    compare("bundled 84-point set data/synthetic/hidden_effect.csv (DOP + BRDF), model paper", bundled_set(), args.seeds)
-    if args.ptfe:
-        compare("PTFE 0.633 um, full Mueller + BRDF, paper+polarized_diffuse", ptfe_set(), args.seeds)
+    if "dop" in args.sets:
+        compare("84-point synthetic DOP set (noise 0.005)", dop_set(), args.seeds)
+    if "bundled" in args.sets:
+        compare("bundled 84-point set data/synthetic/hidden_effect.csv (DOP + BRDF), model paper", bundled_set(), args.seeds)
+    if "ptfe" in args.sets:
+        # NUTS there: a short fixed run (its trees hit the depth cap; to convergence it ran > 10 min), to measure
+        # the cost per draw and the leapfrog steps, not a converged posterior
+        compare("PTFE 0.633 um, full Mueller + BRDF, paper+polarized_diffuse", ptfe_set(), args.seeds,
+                nuts_options={"warmup": 200, "draws": 100, "max_draws": 100})
 
+    posterior = dop_set()
     data, model = posterior.likelihood.data, posterior.likelihood.model
     objective = PaperObjective(data, model, PriorSet(model.parameters))
     ga = [optimize("ga", objective, np.random.default_rng(seed), model.name) for seed in range(args.seeds)]

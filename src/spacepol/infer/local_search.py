@@ -1,4 +1,6 @@
-"""Local polishing in the prior's unit cube: L-BFGS-B with a batched finite-difference gradient.
+"""Local polishing in the prior's unit cube: L-BFGS-B with the exact JAX gradient (``polish_with_gradient``,
+``differentiable.cube_objective``) or a batched finite-difference gradient (``polish``, for objectives that
+are not the posterior, e.g. the paper's eq 25).
 
 scipy's own finite differences call the objective once per parameter, each call a separate model
 evaluation of one parameter set; the model is vectorised over parameter sets, so evaluating the point
@@ -36,3 +38,12 @@ def polish(f, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np
                    bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
     u = np.clip(res.x, 0.0, 1.0)
     return float(f(u[None, :])[0]), u
+
+
+def polish_with_gradient(value_and_gradient, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np.ndarray]:
+    """The local minimum on [0, 1]^D nearest ``start`` of a function returning (value, exact gradient)."""
+    start = np.clip(np.asarray(start, float), 0.0, 1.0)
+    res = minimize(lambda u: value_and_gradient(np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
+                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
+    u = np.clip(res.x, 0.0, 1.0)
+    return float(value_and_gradient(u)[0]), u

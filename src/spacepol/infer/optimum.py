@@ -6,17 +6,21 @@ Three searches, the best (by the full posterior) wins:
   ``specular`` (PTFE, paints, glass) is a sliver of the cube under the default prior k ~ U(0, 20)
   (k < 0.05 is 0.25 % of it) and DE converges on an absorbing optimum before it looks there, so a
   second DE runs with k pinned at 0;
-* a multistart: 8192 scrambled Sobol points, the best 8 polished by L-BFGS-B. Thin films make the
+* a multistart: 8192 scrambled Sobol points, the best 8 polished by L-BFGS-B (exact JAX gradients on
+  large data sets, batched finite differences on small ones, whichever is faster). Thin films make the
   posterior a comb of interference orders in which DE settles on a wrong tooth (a film hidden
   at 0.25 um: DE -443, multistart +845 in log posterior, the truth +841).
+DE stays: it is the cheapest of the three (0.04 s on 84 points) and on the ridge sets it finds the optimum
+every time; the multistart is what finds films and PTFE's optimum (``benchmarks/optimum_speed.py``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .engines.de import run_de
 from . import local_search
+from .differentiable import cube_objective
+from .engines.de import run_de
 from .objective import NegativeLogPosterior
 from .posterior import Posterior
 from .priors import Fixed
@@ -58,8 +62,19 @@ def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: in
     return best_value, best
 
 
-def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 8192, polish: int = 8) -> tuple[float, np.ndarray]:
-    """Best of ``polish`` L-BFGS-B runs started at the best of ``points`` Sobol points in the prior cube."""
+# Above this many numbers x (parameters + 1) a finite-difference gradient (one batch of D + 1 rows) costs more
+# than the exact reverse-mode one (``benchmarks/optimum_speed.py``: 84-168 numbers, D 5-7: the JAX gradient
+# multistart 0.4-0.7x as fast, its L-BFGS iterating longer; PTFE, 29,184 numbers, D 10: 1.3x faster)
+_GRADIENT_PAYS = 100_000
+
+
+def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 8192, polish: int = 8,
+               gradient: bool | None = None) -> tuple[float, np.ndarray]:
+    """Best of ``polish`` L-BFGS-B runs started at the best of ``points`` Sobol points in the prior cube;
+    ``gradient``: exact JAX gradients (``differentiable.cube_objective``) or batched finite differences;
+    by default gradients where they pay (large data sets)."""
+    if gradient is None:
+        gradient = posterior.likelihood.n_obs * (posterior.ndim + 1) > _GRADIENT_PAYS
     from scipy.stats import qmc
 
     objective, priors = NegativeLogPosterior(posterior), posterior.priors
@@ -72,8 +87,10 @@ def multistart(posterior: Posterior, rng: np.random.Generator, points: int = 819
     values = np.concatenate([f(u[i : i + batch]) for i in range(0, points, batch)])
     starts = u[np.argsort(values)[:polish]]
     best_value, best_u = np.inf, starts[0]
+    if gradient:
+        value_and_gradient = cube_objective(posterior)
     for start in starts:
-        value, u = local_search.polish(f, start)
+        value, u = local_search.polish_with_gradient(value_and_gradient, start) if gradient else local_search.polish(f, start)
         if value < best_value:
             best_value, best_u = value, u
     theta = priors.rescale(best_u[None, :])[0]

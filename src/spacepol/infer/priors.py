@@ -2,7 +2,7 @@
 
 ``rescale`` lets the GA, nlopt and differential evolution search the very cube the sampler
 sees: a point ``u`` in [0, 1]^d maps to parameter values through each prior's inverse CDF; ``cdf`` is
-its exact inverse. ``rescale`` also takes JAX arrays (the gradient samplers trace it).
+its exact inverse. ``rescale`` and ``ln_prob`` also take JAX arrays (gradient methods trace them).
 """
 
 from __future__ import annotations
@@ -51,6 +51,10 @@ def _array(u):
     return u if isinstance(u, jax.Array) else np.asarray(u, dtype=float)
 
 
+def _module(u):
+    return jax.numpy if isinstance(u, jax.Array) else np
+
+
 def _check_interval(lower: float, upper: float, what: str) -> None:
     if not (np.isfinite(lower) and np.isfinite(upper)):
         raise ParameterError(f"{what}: bounds must be finite, got [{lower}, {upper}]")
@@ -67,9 +71,9 @@ class Uniform(Prior):
         _check_interval(self.lower, self.upper, "Uniform prior")
 
     def ln_prob(self, x):
-        x = np.asarray(x, dtype=float)
+        x, xp = _array(x), _module(x)
         inside = (x >= self.lower) & (x <= self.upper)
-        return np.where(inside, -np.log(self.upper - self.lower), -np.inf)
+        return xp.where(inside, -np.log(self.upper - self.lower), -np.inf)
 
     def rescale(self, u):
         return self.lower + (self.upper - self.lower) * _array(u)
@@ -94,11 +98,11 @@ class LogUniform(Prior):
             raise ParameterError(f"LogUniform prior: lower bound must be > 0, got {self.lower}")
 
     def ln_prob(self, x):
-        x = np.asarray(x, dtype=float)
+        x, xp = _array(x), _module(x)
         inside = (x >= self.lower) & (x <= self.upper)
         with np.errstate(divide="ignore", invalid="ignore"):
-            value = -np.log(x) - np.log(np.log(self.upper / self.lower))
-        return np.where(inside, value, -np.inf)
+            value = -xp.log(x) - np.log(np.log(self.upper / self.lower))
+        return xp.where(inside, value, -np.inf)
 
     def rescale(self, u):
         return self.lower * (self.upper / self.lower) ** _array(u)
@@ -138,11 +142,11 @@ class TruncatedNormal(Prior):
         return special.ndtr(a), special.ndtr(b)
 
     def ln_prob(self, x):
-        x = np.asarray(x, dtype=float)
+        x, xp = _array(x), _module(x)
         lo, hi = self._cdf_bounds()
         z = (x - self.mu) / self.sigma
         value = -0.5 * z**2 - np.log(self.sigma * np.sqrt(2 * np.pi) * (hi - lo))
-        return np.where((x >= self.lower) & (x <= self.upper), value, -np.inf)
+        return xp.where((x >= self.lower) & (x <= self.upper), value, -np.inf)
 
     def rescale(self, u):
         lo, hi = self._cdf_bounds()

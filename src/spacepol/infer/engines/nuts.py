@@ -20,23 +20,18 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ..differentiable import log_likelihood_function
 from ..result import Result
 from ..sampling_space import SamplingSpace
 
 
 def _potential(posterior, space):
-    """-log p(z | data): the compiled likelihood's pure function, composed with the space's transform."""
-    lik = posterior.likelihood
-    names = tuple(posterior.names)
-    scalars = tuple(sorted((k, float(v)) for k, v in posterior.priors.fixed.items()))
-    total = None if posterior.prior_only else lik.function(1, names, scalars)
+    """-log p(z | data): the likelihood's pure JAX function composed with the space's transform."""
+    ll = log_likelihood_function(posterior)
 
     def potential(z):
-        lp = space.ln_prior(z)
-        if total is not None:
-            ll = total(space.to_theta(z[None, :]))[0]
-            lp = lp + jnp.where(jnp.isnan(ll), -jnp.inf, ll)
-        return -lp
+        value = ll(space.to_theta(z[None, :])[0])
+        return -(space.ln_prior(z) + jnp.where(jnp.isnan(value), -jnp.inf, value))
 
     return potential
 

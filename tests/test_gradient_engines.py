@@ -80,24 +80,47 @@ def _prior_only_check(result, priors, names):
     return worst
 
 
-@pytest.mark.parametrize("engine", ["emcee", "nuts"])
-def test_prior_only_run_in_the_logit_space_returns_the_declared_priors(engine):
-    """Non-uniform priors (truncated normal, log-uniform) sampled through the logit space come back as
-    declared: the Jacobian is right. Negative control: the same samples judged against a wrong prior fail."""
+@pytest.mark.parametrize("engine,declared", [("emcee", ()), ("nuts", ()), ("emcee", ("sigma",))])
+def test_prior_only_run_returns_the_declared_priors(engine, declared):
+    """Non-uniform priors (truncated normal, log-uniform) sampled through the logit space (and, for emcee, with
+    sigma kept in its own coordinates) come back as declared: the Jacobian is right. Negative control: the same samples
+    judged against a wrong prior fail."""
     from spacepol.infer.engines.emcee_sampler import sample_emcee
     from spacepol.infer.engines.nuts import sample_nuts
 
     post = dop_posterior(MIXED)
     post.prior_only = True
+    space = SamplingSpace(post.priors, declared=declared)
     if engine == "emcee":
-        res = sample_emcee(post, np.random.default_rng(3), walkers=32, max_steps=3000, progress=False, initial="prior")
+        res = sample_emcee(post, np.random.default_rng(3), walkers=32, max_steps=3000, progress=False, initial="prior",
+                           space=space)
     else:
         res = sample_nuts(post, np.random.default_rng(3), warmup=300, draws=1000, max_draws=1000, progress=False,
-                          initial="prior")
+                          initial="prior", space=space)
     priors = post.priors.priors
     assert _prior_only_check(res, priors, res.names) < 4
     wrong = dict(priors, n=Uniform(0.5, 3.0), sigma=Uniform(0.02, 0.8))
     assert _prior_only_check(res, wrong, res.names) > 6
+
+
+def test_a_parameter_whose_posterior_reaches_its_bound_keeps_its_own_coordinates():
+    """k of a dielectric (truth 0, R depends on k^2): the log posterior hardly changes with k moved to 0, so k
+    stays declared; moving n, sigma or rho_d alone to a bound ruins the DOP, so they keep the logit. On the
+    k_s/rho_d ridge (DOP alone) n, k, sigma keep it too (k_s may not: the wedge's mass lies against k_s = 1)."""
+    from spacepol.infer.optimum import find_optimum
+    from spacepol.infer.sampling_space import reaching_a_bound
+
+    model = Model.from_string("paper")
+    g = default_grid()
+    data = Dataset(g.theta_i, g.theta_r, g.dphi)
+    truth = {**TRUTH, "n": 1.5, "k": 0.0}
+    data.dop = model.evaluate(truth, data.geometry).dop + 0.005 * np.random.default_rng(1).standard_normal(g.size)
+    data.dop_err = np.full(g.size, 0.005)
+    post = Posterior.build(data, model)
+    _, centre = find_optimum(post, np.random.default_rng(0))
+    assert reaching_a_bound(post, centre) == ["k"]
+    ridge = dop_posterior()
+    assert not {"n", "k", "sigma", "rho_d"} & set(reaching_a_bound(ridge, find_optimum(ridge, np.random.default_rng(0))[1]))
 
 
 def test_nuts_and_emcee_reach_the_same_posterior_on_the_ridge():

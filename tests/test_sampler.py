@@ -40,11 +40,11 @@ def test_resumed_chain_equals_uninterrupted(tmp_path):
         def log_prob(self, theta):
             return self.inner.log_prob(theta)
 
-        def log_likelihood(self, theta):  # what the sampler calls every step
+        def log_likelihood(self, theta, inside=None):  # what the sampler calls every step
             self.calls += 1
             if self.calls == self.after:
                 raise KeyboardInterrupt  # Ctrl-C in the middle of a step
-            return self.inner.log_likelihood(theta)
+            return self.inner.log_likelihood(theta, inside)
 
     with pytest.raises(KeyboardInterrupt):
         sample_emcee(Interrupting(post, after=451), np.random.default_rng(7), backend_path=tmp_path / "b.h5", **kwargs)

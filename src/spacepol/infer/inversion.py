@@ -31,7 +31,7 @@ class Inversion:
     identifiability: dict
 
 
-def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.name) -> str:
+def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.family) -> str:
     lik = posterior.likelihood
     h = hashlib.sha256()
     h.update(lik.model.name.encode())
@@ -84,7 +84,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     walkers = check_walkers(walkers, posterior.ndim)
     if backend_path is not None:
         backend_path = Path(backend_path)
-        print_ = fingerprint(posterior, walkers, seed, (space or SamplingSpace).name)
+        print_ = fingerprint(posterior, walkers, seed, (space or SamplingSpace).family)
         _check_backend(backend_path, print_)
         _stamp_backend(backend_path, print_)  # before sampling, so an interrupted chain is recognised
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,

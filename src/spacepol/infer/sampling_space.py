@@ -1,4 +1,4 @@
-"""Where the samplers move: each free parameter as the logit of its prior's CDF.
+"""Where the samplers move: each free parameter as the logit of its prior's CDF, unless it piles up at a bound.
 
     z_j = logit(F_j(theta_j)),    theta_j = F_j^-1(sigmoid(z_j))
 
@@ -14,8 +14,15 @@ both leaves DOP unchanged), so with uniform priors the posterior is a wedge from
 (k_s, rho_d) plane, 100x narrower near zero than near the top, which no fixed proposal scale crosses
 quickly. Near a lower bound z is log(theta - lower), so the wedge becomes a straight band of constant
 width (log k_s - log rho_d = const): emcee's affine-invariant moves and NUTS's dense mass matrix both
-follow a straight band, whatever its direction (``benchmarks/inversion_speed.py``: tau 50-76 -> ~30
+follow a straight band, whatever its direction (``benchmarks/inversion_speed.py``: tau 81-99 -> ~30
 steps on the 84-point DOP set). Any other linear ridge the Fisher analysis finds is handled the same way.
+
+Except: a parameter whose posterior reaches a bound of its prior with a density that does not vanish there
+(a dielectric's k near 0) stays in its declared coordinates (``reaching_a_bound``). There the logit would
+turn the pile-up against the bound into an exponential tail to z = -inf, curved against n: four such k's (a
+four-wavelength dielectric, tests/test_spectral.py) made tau 122 and the chain 12,000 steps, still short of
+R-hat 1.01; with those four k's declared tau was 60 and it converged at 6,500 steps (declared throughout:
+tau 64, 7,000 steps).
 """
 
 from __future__ import annotations
@@ -25,78 +32,118 @@ import jax.numpy as jnp
 import numpy as np
 
 from .prior_set import PriorSet
-from .priors import Uniform
 
 _U_FLOOR = 1e-15  # a parameter exactly at a bound maps to a finite z (|z| <= 34.5)
+_REACH = 5.0  # a bound where the log posterior is within this of the centre's is inside the posterior's reach
+
+
+def reaching_a_bound(posterior, centre) -> list[str]:
+    """The free parameters whose prior bound the posterior reaches: moved alone from ``centre`` (an optimum) to
+    its lower or upper bound, the log posterior falls by less than 5 (one vectorised call of 2D + 1 rows).
+
+    That is the pile-up case (a dielectric's k, where R depends on k^2 and the likelihood is flat towards
+    k = 0), not the ridge case: moving k_s alone to 0 makes DOP 0 everywhere, so the wedge's parameters, whose
+    density vanishes at the origin, keep the logit."""
+    centre = np.asarray(centre, float)
+    bounds = posterior.priors.bounds
+    rows = np.repeat(centre[None, :], 2 * len(centre) + 1, axis=0)
+    for j in range(len(centre)):
+        rows[1 + 2 * j, j], rows[2 + 2 * j, j] = bounds[j]
+    lp = posterior.log_prob(rows)
+    if not np.isfinite(lp[0]):
+        return []
+    drop = lp[0] - np.maximum(lp[1::2], lp[2::2])
+    return [n for n, d in zip(posterior.priors.names, drop) if d < _REACH]
 
 
 class SamplingSpace:
-    """The logit-of-CDF coordinates of a PriorSet's free parameters (numpy and JAX)."""
+    """The sampler's coordinates of a PriorSet's free parameters: the logit of each prior's CDF, except the
+    parameters named in ``declared``, which keep their own values (numpy and JAX)."""
 
-    name = "logit-cdf"
+    family = "logit-cdf"
 
-    def __init__(self, priors: PriorSet):
+    def __init__(self, priors: PriorSet, declared=()):
         self.priors = priors
         self.names = priors.names
-        free = [priors.priors[n] for n in self.names]
-        self._uniform = None
-        if all(type(p) is Uniform for p in free):
-            lower = np.array([p.lower for p in free])
-            self._uniform = (lower, np.array([p.upper for p in free]) - lower)
+        unknown = set(declared) - set(self.names)
+        if unknown:
+            raise ValueError(f"not free parameters: {', '.join(sorted(unknown))}")
+        self.declared = [n for n in self.names if n in set(declared)]
+        self._logit = np.array([n not in set(declared) for n in self.names])
+        self._priors = [priors.priors[n] for n in self.names]
+
+    @property
+    def name(self) -> str:
+        """What the chain file records: the family, and the parameters kept in their declared coordinates."""
+        return self.family + (f" except {','.join(self.declared)}" if self.declared else "")
+
+    @classmethod
+    def from_name(cls, priors: PriorSet, name: str) -> "SamplingSpace":
+        if name == DeclaredSpace.family:
+            return DeclaredSpace(priors)
+        _, _, rest = name.partition(" except ")
+        return cls(priors, [n for n in rest.split(",") if n])
 
     def to_z(self, theta) -> np.ndarray:
         theta = np.atleast_2d(np.asarray(theta, float))
-        u = np.column_stack([self.priors.priors[n].cdf(theta[:, j]) for j, n in enumerate(self.names)])
-        u = np.clip(u, _U_FLOOR, 1.0 - _U_FLOOR)
-        return np.log(u) - np.log1p(-u)
+        z = theta.copy()
+        for j, prior in enumerate(self._priors):
+            if self._logit[j]:
+                u = np.clip(prior.cdf(theta[:, j]), _U_FLOOR, 1.0 - _U_FLOOR)
+                z[:, j] = np.log(u) - np.log1p(-u)
+        return z
 
     def to_theta(self, z):
         """theta for z (W, D); numpy in, numpy out; JAX in (traced), JAX out."""
         if isinstance(z, jax.Array):
             u = jax.nn.sigmoid(z)
-            return jnp.stack([self.priors.priors[n].rescale(u[..., j]) for j, n in enumerate(self.names)], axis=-1)
+            return jnp.stack([p.rescale(u[..., j]) if self._logit[j] else z[..., j] for j, p in enumerate(self._priors)],
+                             axis=-1)
         z = np.atleast_2d(np.asarray(z, float))
         u = 0.5 * (1.0 + np.tanh(0.5 * z))  # sigmoid without overflow
-        if self._uniform is not None:  # every prior uniform: one vector operation (emcee calls this every step)
-            lower, width = self._uniform
-            return np.minimum(lower + width * u, lower + width)
-        return np.column_stack([self.priors.priors[n].rescale(u[:, j]) for j, n in enumerate(self.names)])
+        return np.column_stack([p.rescale(u[:, j]) if self._logit[j] else z[:, j] for j, p in enumerate(self._priors)])
 
     def ln_prior(self, z):
-        """The declared priors' log density in z: sum of log sigmoid(z) + log sigmoid(-z) over the last axis."""
-        xp = jnp if isinstance(z, jax.Array) else np
-        a = xp.abs(z)
-        return -xp.sum(a + 2.0 * xp.log1p(xp.exp(-a)), axis=-1)
+        """The declared priors' log density in z (rows over the last axis): log sigmoid(z) + log sigmoid(-z) for
+        a logit coordinate, the prior's own ln_prob (-inf outside its support) for a declared one."""
+        jax_ = isinstance(z, jax.Array)
+        xp = jnp if jax_ else np
+        total = 0.0
+        for j, prior in enumerate(self._priors):
+            zj = z[..., j]
+            if self._logit[j]:
+                a = xp.abs(zj)
+                total = total - (a + 2.0 * xp.log1p(xp.exp(-a)))
+            else:
+                total = total + prior.ln_prob(zj)
+        return total
 
     def log_prob(self, posterior):
         """The posterior's log density in z, vectorised over rows (what emcee calls)."""
 
         def log_prob_z(z):
             z = np.atleast_2d(z)
-            return posterior.log_likelihood(self.to_theta(z)) + self.ln_prior(z)
+            lp = self.ln_prior(z)
+            inside = np.isfinite(lp)
+            return lp + posterior.log_likelihood(self.to_theta(z), inside)
 
         return log_prob_z
 
     def log_posterior_theta(self, z, log_prob_z) -> np.ndarray:
         """The log posterior in the declared parameters (as ``Posterior.log_prob``) from the z-space value."""
-        theta = self.to_theta(np.reshape(z, (-1, z.shape[-1])))
-        lp = np.reshape(log_prob_z, -1) - self.ln_prior(np.reshape(z, (-1, z.shape[-1]))) + self.priors.ln_prob(theta)
+        flat = np.reshape(z, (-1, z.shape[-1]))
+        lp = np.reshape(log_prob_z, -1) - self.ln_prior(flat) + self.priors.ln_prob(self.to_theta(flat))
         return lp.reshape(np.shape(log_prob_z))
 
 
 class DeclaredSpace(SamplingSpace):
     """The declared parameters themselves (the baseline the benchmarks compare with): z = theta."""
 
-    name = "declared"
+    family = "declared"
 
-    def to_z(self, theta) -> np.ndarray:
-        return np.atleast_2d(np.asarray(theta, float)).copy()
+    def __init__(self, priors: PriorSet):
+        super().__init__(priors, declared=priors.names)
 
-    def to_theta(self, z):
-        return z if isinstance(z, jax.Array) else np.atleast_2d(np.asarray(z, float))
-
-    def ln_prior(self, z):
-        return self.priors.ln_prob(z)
-
-    def log_prob(self, posterior):
-        return posterior.log_prob
+    @property
+    def name(self) -> str:
+        return self.family

@@ -4,9 +4,10 @@
   posterior (inside the prior support), not scattered over the prior (``initial="prior"``
   does that, or pass an array).
 * Space: the walkers move in the logit of each prior's CDF (``infer.sampling_space``), where the
-  declared priors are kept exactly and the wedge DOP leaves between k_s and rho_d is a straight band;
-  the chain file holds those coordinates, the Result the declared parameters. On the 84-point DOP set
-  tau fell from 50-76 to ~30 steps (``benchmarks/inversion_speed.py``).
+  declared priors are kept exactly and the wedge DOP leaves between k_s and rho_d is a straight band,
+  except parameters whose posterior reaches a prior bound (a dielectric's k near 0); the chain file holds those
+  coordinates (and says which), the Result the declared parameters. On the 84-point DOP set tau fell from
+  81-99 to ~30 steps (``benchmarks/inversion_speed.py``).
 * Moves: differential evolution (80 %) and DE snooker (20 %): DE moves follow the long ridges that
   DOP-only data leave (k_s against rho_d). In the logit space the stretch move needed tau ~ 80, DE
   alone ~ 40, DE + snooker ~ 30 at 1.4x DE's cost per step: about equal per second.
@@ -33,7 +34,7 @@ import numpy as np
 
 from ..buffered_backend import BufferedHDFBackend
 from ..result import Result
-from ..sampling_space import SamplingSpace
+from ..sampling_space import SamplingSpace, reaching_a_bound
 
 
 def default_walkers(ndim: int) -> int:
@@ -95,6 +96,22 @@ def _moves():
     return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
 
 
+def _store_space(path, space) -> None:
+    """The chain file holds the sampler's coordinates; it records which, so a resumed run uses the same."""
+    import h5py
+
+    with h5py.File(path, "a") as f:
+        f.attrs["spacepol_space"] = space.name
+
+
+def _stored_space(path, priors) -> SamplingSpace:
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        name = f.attrs.get("spacepol_space", SamplingSpace.family)
+    return SamplingSpace.from_name(priors, str(name))
+
+
 def _tau_at(sampler, iteration: int) -> np.ndarray:
     """The integrated autocorrelation time of the first ``iteration`` steps (what an uninterrupted run
     computed when it stood there), so a resumed run takes the same decisions."""
@@ -135,7 +152,19 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     # compiled size, 64, tripled the cost of a full-Mueller step)
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
-    space = space or SamplingSpace(posterior.priors)
+    if resumed:
+        space = space or _stored_space(backend_path, posterior.priors)
+    else:
+        random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
+        if initial is None:
+            initial = initial_ball(posterior, rng, walkers)
+        elif isinstance(initial, str) and initial == "prior":
+            initial = posterior.priors.sample(rng, walkers)
+        initial = np.atleast_2d(np.asarray(initial, float))
+        if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
+            space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
+        if backend_path is not None:
+            _store_space(backend_path, space)
     sampler = emcee.EnsembleSampler(walkers, ndim, space.log_prob(posterior), vectorize=True, moves=_moves(),
                                     backend=backend)
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True
@@ -167,11 +196,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         if progress and done < max_steps:
             print(f"  resuming the chain in {backend_path} at step {done}", file=sys.stderr)
     else:
-        sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-        if initial is None:
-            initial = initial_ball(posterior, rng, walkers)
-        elif isinstance(initial, str) and initial == "prior":
-            initial = posterior.priors.sample(rng, walkers)
+        sampler.random_state = random_state
         state = space.to_z(initial)
 
     while sampler.iteration < max_steps:

@@ -2,6 +2,9 @@
 
 * Space: the logit of each prior's CDF (``infer.sampling_space``), as for emcee: the declared priors
   kept exactly (their density is the logistic in z), no bounds, the k_s/rho_d wedge a straight band.
+  Every parameter, unlike emcee's space: a parameter kept in its declared coordinates puts a wall at its
+  bound, and NUTS diverges on it (prior-only, sigma declared: 3,859 divergent of 4,000 draws); the curved
+  exponential tail the logit makes of a pile-up at a bound, which slows emcee, is smooth for NUTS.
 * Mass matrix: dense, adapted in warm-up (a linear ridge then costs nothing).
 * Chains: ``chains`` independent chains (4: R-hat needs several), vectorised into one compiled program
   (one CPU device; numpyro's ``vectorized`` method), started in a small ball around the optimum.
@@ -49,17 +52,19 @@ def _rhat_ess(z):
 def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: int = 500, draws: int = 500,
                 max_draws: int = 8000, target_accept: float = 0.8, initial=None, progress: bool = True,
                 model_name: str = "", seed: int | None = None, rhat_target: float = 1.01,
-                ess_target: float = 400.0) -> Result:
+                ess_target: float = 400.0, space=None) -> Result:
+    """``space``: the coordinates the chains move in (default: the logit space, every parameter)."""
     from numpyro.infer import MCMC, NUTS
 
     from .emcee_sampler import initial_ball
 
     start = time.perf_counter()
-    space = SamplingSpace(posterior.priors)
     if initial is None:
         initial = initial_ball(posterior, rng, chains)
     elif isinstance(initial, str) and initial == "prior":
         initial = posterior.priors.sample(rng, chains)
+    initial = np.atleast_2d(np.asarray(initial, float))
+    space = space or SamplingSpace(posterior.priors)
     z0 = jnp.asarray(space.to_z(initial))
     kernel = NUTS(potential_fn=_potential(posterior, space), dense_mass=True, target_accept_prob=target_accept)
     mcmc = MCMC(kernel, num_warmup=warmup, num_samples=draws, num_chains=chains, chain_method="vectorized",

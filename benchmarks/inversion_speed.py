@@ -97,7 +97,7 @@ def compare(label, posterior, seeds, engines, nuts_options=None):
     rows = {}
     candidates = {"declared": ("emcee, declared parameters", lambda s: run_emcee(posterior, s, DeclaredSpace(posterior.priors))),
                   "emcee": ("emcee, logit-CDF space", lambda s: run_emcee(posterior, s, None)),
-                  "nuts": ("NUTS, logit-CDF space", lambda s: run_nuts(posterior, s, **(nuts_options or {}))))}
+                  "nuts": ("NUTS, logit-CDF space", lambda s: run_nuts(posterior, s, **(nuts_options or {})))}
     for engine, fn in (candidates[e] for e in engines):
         walls, rates = [], []
         for seed in range(seeds):

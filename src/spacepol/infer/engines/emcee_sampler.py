@@ -81,11 +81,17 @@ def _tau(chain) -> np.ndarray:
     return emcee.autocorr.integrated_time(chain, tol=0)
 
 
-def _rhat_ess(sampler, tau):
+def _declared(chain_z, space) -> np.ndarray:
+    """A (steps, walkers, D) chain of the sampler's coordinates in the declared parameters: the stopping rule
+    judges what the report shows (R-hat's folded part and tau's estimate differ between coordinates)."""
+    return space.to_theta(chain_z.reshape(-1, chain_z.shape[-1])).reshape(chain_z.shape)
+
+
+def _rhat_ess(sampler, tau, space):
     import arviz as az
 
     burn, thin = _kept(sampler, tau)
-    chain = sampler.get_chain(discard=burn, thin=thin)  # (draws, walkers, D)
+    chain = _declared(sampler.get_chain(discard=burn, thin=thin), space)  # (draws, walkers, D)
     data = az.convert_to_dataset({f"p{j}": chain[:, :, j].T for j in range(chain.shape[2])})
     rhat = float(az.rhat(data).to_array().max())
     ess = float(min(az.ess(data, method="bulk").to_array().min(), az.ess(data, method="tail").to_array().min()))
@@ -112,10 +118,10 @@ def _stored_space(path, priors) -> SamplingSpace:
     return SamplingSpace.from_name(priors, str(name))
 
 
-def _tau_at(sampler, iteration: int) -> np.ndarray:
+def _tau_at(sampler, iteration: int, space) -> np.ndarray:
     """The integrated autocorrelation time of the first ``iteration`` steps (what an uninterrupted run
     computed when it stood there), so a resumed run takes the same decisions."""
-    return _tau(sampler.get_chain()[:iteration])
+    return _tau(_declared(sampler.get_chain()[:iteration], space))
 
 
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
@@ -173,7 +179,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         settled = (previous_tau is not None and np.all(np.isfinite(tau)) and np.all(np.isfinite(previous_tau))
                    and np.all(np.abs(previous_tau - tau) < 0.05 * tau))
         long_enough = sampler.iteration >= max(min_steps, tau_multiple * np.max(tau)) and settled
-        rhat, ess = (_rhat_ess(sampler, tau) if long_enough else (np.nan, np.nan))
+        rhat, ess = (_rhat_ess(sampler, tau, space) if long_enough else (np.nan, np.nan))
         return long_enough and rhat <= rhat_target and ess >= ess_target, long_enough, rhat, ess
 
     if resumed:
@@ -182,9 +188,9 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         at_check = done % check_every == 0 or done >= max_steps
         before = (done - check_every if done % check_every == 0 else done // check_every * check_every) if at_check \
             else done // check_every * check_every  # the check whose tau an uninterrupted run holds next
-        previous_tau = _tau_at(sampler, before) if before >= check_every else None
+        previous_tau = _tau_at(sampler, before, space) if before >= check_every else None
         if at_check:  # stopped right at a check: take that check's decision again
-            tau = _tau_at(sampler, done)
+            tau = _tau_at(sampler, done, space)
             ok, *_ = converged(tau, previous_tau)
             if ok or done >= max_steps:
                 capped = not ok
@@ -206,7 +212,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         finally:  # interrupted too: the steps taken so far go to the file, so the same command continues them
             if backend is not None:
                 backend.flush()
-        tau = _tau(sampler.get_chain())
+        tau = _tau(_declared(sampler.get_chain(), space))
         ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau
         if progress:
@@ -218,13 +224,13 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             capped = False
             break
     if not np.all(np.isfinite(tau)):  # no block was run here (a finished chain): measure what is stored
-        tau = _tau_at(sampler, sampler.iteration)
+        tau = _tau_at(sampler, sampler.iteration, space)
 
     tau_max = float(np.max(tau))
     burn, thin = _kept(sampler, tau)
     chain_z = sampler.get_chain(discard=burn, thin=thin)
     log_prob = space.log_posterior_theta(chain_z, sampler.get_log_prob(discard=burn, thin=thin))
-    chain = space.to_theta(chain_z.reshape(-1, ndim)).reshape(chain_z.shape)
+    chain = _declared(chain_z, space)
     flat_i = np.unravel_index(np.argmax(log_prob), log_prob.shape)
     best = chain[flat_i]
     info = {

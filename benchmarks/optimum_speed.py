@@ -84,7 +84,7 @@ def main():
         "DE (4,000 evaluations)": de,
         "multistart, finite differences": lambda p, rng: multistart(p, rng, gradient=False)[0],
         "multistart, JAX gradients": lambda p, rng: multistart(p, rng, gradient=True)[0],
-        "multistart, automatic choice": lambda p, rng: multistart(p, rng)[0],
+        "multistart, automatic choice": lambda p, rng: multistart(p, rng, gradient=None)[0],
     }
     for label, posterior in sets(args.sets):
         print(f"\n{label}: {posterior.ndim} parameters, {posterior.likelihood.n_obs} numbers")

@@ -31,19 +31,21 @@ def value_and_gradient(f, u: np.ndarray) -> tuple[float, np.ndarray]:
     return value, np.where(np.isfinite(grad), grad, 0.0)
 
 
+def _lbfgsb(value_and_gradient, start: np.ndarray, max_iterations: int) -> np.ndarray:
+    """L-BFGS-B on [0, 1]^D from ``start`` for a function of u returning (value, gradient): the minimum's u."""
+    start = np.clip(np.asarray(start, float), 0.0, 1.0)
+    res = minimize(lambda u: value_and_gradient(np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
+                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
+    return np.clip(res.x, 0.0, 1.0)
+
+
 def polish(f, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np.ndarray]:
     """The local minimum of the batched ``f`` on [0, 1]^D nearest ``start``: (value, u)."""
-    start = np.clip(np.asarray(start, float), 0.0, 1.0)
-    res = minimize(lambda u: value_and_gradient(f, np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
-                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
-    u = np.clip(res.x, 0.0, 1.0)
+    u = _lbfgsb(lambda u: value_and_gradient(f, u), start, max_iterations)
     return float(f(u[None, :])[0]), u
 
 
 def polish_with_gradient(value_and_gradient, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np.ndarray]:
     """The local minimum on [0, 1]^D nearest ``start`` of a function returning (value, exact gradient)."""
-    start = np.clip(np.asarray(start, float), 0.0, 1.0)
-    res = minimize(lambda u: value_and_gradient(np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
-                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
-    u = np.clip(res.x, 0.0, 1.0)
+    u = _lbfgsb(value_and_gradient, start, max_iterations)
     return float(value_and_gradient(u)[0]), u

@@ -94,20 +94,22 @@ class SamplingSpace:
         return z
 
     def to_theta(self, z):
-        """theta for z (W, D); numpy in, numpy out; JAX in (traced), JAX out."""
+        """theta for z (..., D), e.g. walkers (W, D) or a chain (steps, walkers, D); a single vector (D,) gives
+        (1, D). numpy in, numpy out; JAX in (traced), JAX out."""
         if isinstance(z, jax.Array):
             u = jax.nn.sigmoid(z)
             return jnp.stack([p.rescale(u[..., j]) if self._logit[j] else z[..., j] for j, p in enumerate(self._priors)],
                              axis=-1)
         z = np.atleast_2d(np.asarray(z, float))
-        u = 0.5 * (1.0 + np.tanh(0.5 * z))  # sigmoid without overflow
-        return np.column_stack([p.rescale(u[:, j]) if self._logit[j] else z[:, j] for j, p in enumerate(self._priors)])
+        flat = z.reshape(-1, z.shape[-1])
+        u = 0.5 * (1.0 + np.tanh(0.5 * flat))  # sigmoid without overflow
+        theta = np.column_stack([p.rescale(u[:, j]) if self._logit[j] else flat[:, j] for j, p in enumerate(self._priors)])
+        return theta.reshape(z.shape)
 
     def ln_prior(self, z):
         """The declared priors' log density in z (rows over the last axis): log sigmoid(z) + log sigmoid(-z) for
         a logit coordinate, the prior's own ln_prob (-inf outside its support) for a declared one."""
-        jax_ = isinstance(z, jax.Array)
-        xp = jnp if jax_ else np
+        xp = jnp if isinstance(z, jax.Array) else np
         total = 0.0
         for j, prior in enumerate(self._priors):
             zj = z[..., j]

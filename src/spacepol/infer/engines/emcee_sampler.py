@@ -81,21 +81,33 @@ def _tau(chain) -> np.ndarray:
     return emcee.autocorr.integrated_time(chain, tol=0)
 
 
-def _declared(chain_z, space) -> np.ndarray:
-    """A (steps, walkers, D) chain of the sampler's coordinates in the declared parameters: the stopping rule
-    judges what the report shows (R-hat's folded part and tau's estimate differ between coordinates)."""
-    return space.to_theta(chain_z.reshape(-1, chain_z.shape[-1])).reshape(chain_z.shape)
-
-
-def _rhat_ess(sampler, tau, space):
+def worst_rhat_ess(chains) -> tuple[float, float]:
+    """The largest rank-normalised split R-hat and the smallest bulk/tail ESS (ArviZ) of a (chains, draws, D)
+    array: what emcee's and NUTS's stopping rules ask for."""
     import arviz as az
 
-    burn, thin = _kept(sampler, tau)
-    chain = _declared(sampler.get_chain(discard=burn, thin=thin), space)  # (draws, walkers, D)
-    data = az.convert_to_dataset({f"p{j}": chain[:, :, j].T for j in range(chain.shape[2])})
+    data = az.convert_to_dataset({f"p{j}": chains[:, :, j] for j in range(chains.shape[2])})
     rhat = float(az.rhat(data).to_array().max())
     ess = float(min(az.ess(data, method="bulk").to_array().min(), az.ess(data, method="tail").to_array().min()))
     return rhat, ess
+
+
+def _rhat_ess(sampler, tau, space):
+    """On the declared parameters (what the report shows: R-hat's folded part and tau's estimate differ between
+    coordinates), walkers as chains."""
+    burn, thin = _kept(sampler, tau)
+    chain = space.to_theta(sampler.get_chain(discard=burn, thin=thin))  # (draws, walkers, D)
+    return worst_rhat_ess(chain.transpose(1, 0, 2))
+
+
+def starting_points(posterior, rng, count: int, initial=None) -> np.ndarray:
+    """(count, D) starting parameter vectors: ``initial`` as given, prior draws for "prior", or by default a
+    small ball around the global optimum."""
+    if initial is None:
+        return initial_ball(posterior, rng, count)
+    if isinstance(initial, str) and initial == "prior":
+        return posterior.priors.sample(rng, count)
+    return np.atleast_2d(np.asarray(initial, float))
 
 
 def _moves():
@@ -121,7 +133,7 @@ def _stored_space(path, priors) -> SamplingSpace:
 def _tau_at(sampler, iteration: int, space) -> np.ndarray:
     """The integrated autocorrelation time of the first ``iteration`` steps (what an uninterrupted run
     computed when it stood there), so a resumed run takes the same decisions."""
-    return _tau(_declared(sampler.get_chain()[:iteration], space))
+    return _tau(space.to_theta(sampler.get_chain()[:iteration]))
 
 
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
@@ -162,11 +174,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         space = space or _stored_space(backend_path, posterior.priors)
     else:
         random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-        if initial is None:
-            initial = initial_ball(posterior, rng, walkers)
-        elif isinstance(initial, str) and initial == "prior":
-            initial = posterior.priors.sample(rng, walkers)
-        initial = np.atleast_2d(np.asarray(initial, float))
+        initial = starting_points(posterior, rng, walkers, initial)
         if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
             space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
         if backend_path is not None:
@@ -212,7 +220,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         finally:  # interrupted too: the steps taken so far go to the file, so the same command continues them
             if backend is not None:
                 backend.flush()
-        tau = _tau(_declared(sampler.get_chain(), space))
+        tau = _tau_at(sampler, sampler.iteration, space)
         ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau
         if progress:
@@ -230,7 +238,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     burn, thin = _kept(sampler, tau)
     chain_z = sampler.get_chain(discard=burn, thin=thin)
     log_prob = space.log_posterior_theta(chain_z, sampler.get_log_prob(discard=burn, thin=thin))
-    chain = _declared(chain_z, space)
+    chain = space.to_theta(chain_z)
     flat_i = np.unravel_index(np.argmax(log_prob), log_prob.shape)
     best = chain[flat_i]
     info = {

@@ -39,14 +39,10 @@ def _potential(posterior, space):
     return potential
 
 
-def _rhat_ess(z):
-    """Worst R-hat and ESS (bulk and tail) of a (chains, draws, D) array."""
-    import arviz as az
-
-    data = az.convert_to_dataset({f"p{j}": z[:, :, j] for j in range(z.shape[2])})
-    rhat = float(az.rhat(data).to_array().max())
-    ess = float(min(az.ess(data, method="bulk").to_array().min(), az.ess(data, method="tail").to_array().min()))
-    return rhat, ess
+def _block(mcmc, fields):
+    """The draws of numpyro's last run, (chains, draws, D), and its extra fields, (chains, draws) each."""
+    return (np.asarray(mcmc.get_samples(group_by_chain=True)),
+            {f: np.asarray(v) for f, v in mcmc.get_extra_fields(group_by_chain=True).items()})
 
 
 def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: int = 500, draws: int = 500,
@@ -56,28 +52,22 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
     """``space``: the coordinates the chains move in (default: the logit space, every parameter)."""
     from numpyro.infer import MCMC, NUTS
 
-    from .emcee_sampler import initial_ball
+    from .emcee_sampler import starting_points, worst_rhat_ess
 
     start = time.perf_counter()
-    if initial is None:
-        initial = initial_ball(posterior, rng, chains)
-    elif isinstance(initial, str) and initial == "prior":
-        initial = posterior.priors.sample(rng, chains)
-    initial = np.atleast_2d(np.asarray(initial, float))
     space = space or SamplingSpace(posterior.priors)
-    z0 = jnp.asarray(space.to_z(initial))
+    z0 = jnp.asarray(space.to_z(starting_points(posterior, rng, chains, initial)))
     kernel = NUTS(potential_fn=_potential(posterior, space), dense_mass=True, target_accept_prob=target_accept)
     mcmc = MCMC(kernel, num_warmup=warmup, num_samples=draws, num_chains=chains, chain_method="vectorized",
                 progress_bar=False)
     key = jax.random.PRNGKey(int(rng.integers(2**31)))
     fields = ("num_steps", "diverging", "potential_energy", "accept_prob")
     mcmc.run(key, init_params=z0, extra_fields=fields)
-    blocks = [(np.asarray(mcmc.get_samples(group_by_chain=True)),
-               {f: np.asarray(v) for f, v in mcmc.get_extra_fields(group_by_chain=True).items()})]
+    blocks = [_block(mcmc, fields)]
     capped = True
     while True:
         z = np.concatenate([b[0] for b in blocks], axis=1)  # (chains, draws, D)
-        rhat, ess = _rhat_ess(z)
+        rhat, ess = worst_rhat_ess(z)
         if progress:
             print(f"  NUTS: {z.shape[1]} draws x {chains} chains, R-hat {rhat:.3f}, ESS {ess:.0f}", file=sys.stderr)
         if rhat <= rhat_target and ess >= ess_target:
@@ -87,12 +77,11 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
             break
         mcmc.post_warmup_state = mcmc.last_state  # more draws with the adapted step size and mass matrix
         mcmc.run(mcmc.post_warmup_state.rng_key, extra_fields=fields)
-        blocks.append((np.asarray(mcmc.get_samples(group_by_chain=True)),
-                       {f: np.asarray(v) for f, v in mcmc.get_extra_fields(group_by_chain=True).items()}))
+        blocks.append(_block(mcmc, fields))
     extra = {f: np.concatenate([b[1][f] for b in blocks], axis=1) for f in fields}
     z_draws = z.transpose(1, 0, 2)  # (draws, chains, D), the Result's layout
     log_prob = space.log_posterior_theta(z_draws, -extra["potential_energy"].T)
-    samples = space.to_theta(z_draws.reshape(-1, z.shape[2])).reshape(z_draws.shape)
+    samples = space.to_theta(z_draws)
     best_i = np.unravel_index(np.argmax(log_prob), log_prob.shape)
     leapfrogs = int(extra["num_steps"].sum())
     info = {

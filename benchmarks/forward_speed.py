@@ -9,7 +9,10 @@ Baselines, each measured here and printed as a ratio:
   * a straightforward numpy implementation of the same equations (eqs 1-3, 7-8, 11, 14-21, 23 with the
     ERRATA corrections), vectorised over (sets, geometries); measured FIRST, before spacepol is imported,
     i.e. with glibc's default heap as any numpy program runs, and again after the import, with the heap
-    spacepol keeps (``spacepol/_runtime.py``: MB-sized temporaries no longer mmap'ed per call);
+    spacepol keeps (``spacepol/_runtime.py``: MB-sized temporaries no longer mmap'ed per call). With the
+    default heap numpy's speed depends on whether the caller still holds the previous call's result (glibc
+    then keeps the top of its heap; measured 60 against 19 M/s): both are timed, "result dropped" is what a
+    sampler's loop does and what the issue measured (15-21 M/s);
   * a per-point Python loop (math module) on a subset.
 The numpy and loop versions are independent implementations, so their largest differences from spacepol
 are printed too (a check, not only a timing). Medians of repeats; the load average is printed.
@@ -30,13 +33,17 @@ import numpy as np
 N_SETS = 4096
 LOOP_SETS = 48
 KEPT = "numpy, spacepol's heap"
+DROPPED = "numpy, default heap, dropped"
 
 
-def timed(fn, repeats):
-    """(median seconds, last result) over ``repeats`` calls after one warm-up call."""
+def timed(fn, repeats, keep=True):
+    """(median seconds, last result) over ``repeats`` calls after one warm-up call; ``keep=False`` lets
+    each result go before the next call (as a loop that uses and discards it)."""
     out = fn()
     times = []
     for _ in range(repeats):
+        if not keep:
+            out = None
         t0 = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - t0)
@@ -157,6 +164,7 @@ def main():
     print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
 
     # 1. numpy baseline before spacepol changes the process (glibc's default heap)
+    t_np_dropped, _ = timed(lambda: numpy_paper_dop(ti, tr, dphi, *columns.values()), repeats, keep=False)
     t_np_default, dop_np = timed(lambda: numpy_paper_dop(ti, tr, dphi, *columns.values()), repeats)
 
     import jax  # noqa: E402  (after the baseline on purpose)
@@ -166,33 +174,43 @@ def main():
     from spacepol.physics import Geometry, Model
     from spacepol.physics.shadowing import PAPER_CONSTANTS, paper_shadowing
 
-    t_np_kept, _ = timed(lambda: numpy_paper_dop(ti, tr, dphi, *columns.values()), repeats)
     model = Model.from_string("paper")
     geometry = Geometry(ti, tr, dphi)
     t_first = time.perf_counter()
-    model.evaluate(sets, geometry, check=False)
+    pred = model.evaluate(sets, geometry, check=False)
     compile_s = time.perf_counter() - t_first
-    t_jax, pred = timed(lambda: model.evaluate(sets, geometry, check=False), repeats)
     data = Dataset(ti, tr, dphi)
     data.dop, data.dop_err = pred.dop[0], np.full(ti.size, 0.01)
     dop_likelihood = Likelihood(data, model)
-    t_lik, _ = timed(lambda: dop_likelihood.total(sets), repeats)
+    # rounds of (numpy, spacepol, likelihood) one after the other: the machine's speed drifts by 2x over
+    # minutes (shared cores), so each round's ratio compares runs that saw the same load
+    rounds = {KEPT: [], "spacepol (JAX) evaluate": [], "spacepol likelihood (DOP)": []}
+    for _ in range(repeats):
+        rounds[KEPT].append(timed(lambda: numpy_paper_dop(ti, tr, dphi, *columns.values()), 3)[0])
+        t, pred = timed(lambda: model.evaluate(sets, geometry, check=False), 3)
+        rounds["spacepol (JAX) evaluate"].append(t)
+        rounds["spacepol likelihood (DOP)"].append(timed(lambda: dop_likelihood.total(sets), 3)[0])
+    t_np_kept, t_jax, t_lik = (statistics.median(v) for v in rounds.values())
+    round_ratio = statistics.median(a / b for a, b in zip(rounds[KEPT], rounds["spacepol (JAX) evaluate"]))
 
     t0 = time.perf_counter()
     loop = np.array([[loop_paper_dop(ti[j], tr[j], dphi[j], *(sets[name][p] for name in sets)) for j in range(ti.size)]
                      for p in range(LOOP_SETS)])
     loop_rate = loop.size / (time.perf_counter() - t0)
 
-    rate = {"numpy, default heap": evals / t_np_default, KEPT: evals / t_np_kept,
+    rate = {DROPPED: evals / t_np_dropped, "numpy, default heap": evals / t_np_default, KEPT: evals / t_np_kept,
             "spacepol (JAX) evaluate": evals / t_jax, "spacepol likelihood (DOP)": evals / t_lik}
-    print(f"\nDOP of `paper`, {N_SETS} sets x {ti.size} geometries ({evals:,} evaluations), median of {repeats}:")
+    print(f"\nDOP of `paper`, {N_SETS} sets x {ti.size} geometries ({evals:,} evaluations), medians of {repeats} "
+          f"(numpy's default heap) or of {repeats} interleaved rounds of 3 (the rest):")
     for name, r in rate.items():
         print(f"  {name:28s} {r / 1e6:8.1f} M evaluations/s")
     print(f"  {'per-point Python loop':28s} {loop_rate / 1e6:8.3f} M evaluations/s ({LOOP_SETS} sets)")
-    print(f"  ratio spacepol / numpy (default heap): {rate['spacepol (JAX) evaluate'] / rate['numpy, default heap']:.1f}x; "
-          f"/ numpy (spacepol's heap): {rate['spacepol (JAX) evaluate'] / rate[KEPT]:.1f}x; "
-          f"/ loop: {rate['spacepol (JAX) evaluate'] / loop_rate:.0f}x; likelihood / numpy (default heap): "
-          f"{rate['spacepol likelihood (DOP)'] / rate['numpy, default heap']:.1f}x")
+    best_numpy = max(rate[DROPPED], rate["numpy, default heap"], rate[KEPT])
+    print(f"  ratio spacepol / numpy: {rate['spacepol (JAX) evaluate'] / rate[DROPPED]:.1f}x (default heap, result dropped), "
+          f"{rate['spacepol (JAX) evaluate'] / best_numpy:.1f}x (numpy's fastest of the three); / loop: "
+          f"{rate['spacepol (JAX) evaluate'] / loop_rate:.0f}x; likelihood / fastest numpy: {rate['spacepol likelihood (DOP)'] / best_numpy:.1f}x")
+    print(f"  per round, spacepol / numpy with spacepol's heap: median {round_ratio:.1f}x "
+          f"(rounds {', '.join(f'{a / b:.1f}' for a, b in zip(rounds[KEPT], rounds['spacepol (JAX) evaluate']))})")
     print(f"  first call (compilation included): {compile_s:.2f} s")
     print(f"  max |DOP difference| spacepol vs numpy: {np.max(np.abs(pred.dop - dop_np)):.1e}, vs loop: "
           f"{np.max(np.abs(pred.dop[:LOOP_SETS] - loop)):.1e}")

@@ -84,3 +84,20 @@ def test_rotated_mueller_is_the_product_of_rotations_and_fresnel_matrix():
     # negative control: the rotations swapped give a different matrix
     swapped = fresnel.rotated_mueller(r_s, r_p, np.cos(2 * eta_r), np.sin(2 * eta_r), np.cos(2 * eta_i), np.sin(2 * eta_i), scale)
     assert np.max(np.abs(swapped - got)) > 1e-2
+
+
+def test_real_arithmetic_entries_equal_the_complex_ones():
+    """The full-Mueller hot path (real arithmetic) gives the entries of the tmm-checked complex amplitudes,
+    over metals, weak absorbers, dielectrics, n < 1 with total internal reflection, and grazing angles."""
+    rng = np.random.default_rng(11)
+    n = np.concatenate([rng.uniform(0.05, 5.0, 400), [1.5, 0.5, 1.0 + 1e-9, 1.405]])
+    k = np.concatenate([rng.uniform(0.0, 20.0, 200), 10.0 ** rng.uniform(-8, 0, 200), [0.0, 0.0, 0.0, 0.2289]])
+    theta = np.radians(np.concatenate([rng.uniform(0.0, 89.99, 404)]))
+    cos_t, sin2_t = np.cos(theta), np.sin(theta) ** 2
+    want = fresnel.matrix_entries(*fresnel.amplitudes(n + 1j * k, cos_t, sin2_t))
+    got = fresnel.interface_matrix_entries(n, k, cos_t, sin2_t)
+    for name, w, g in zip("abcd", want, got):
+        np.testing.assert_allclose(g, w, rtol=0, atol=1e-13, err_msg=name)
+    # negative control: swapping s and p changes b and d
+    swapped = fresnel.matrix_entries(*fresnel.amplitudes(n + 1j * k, cos_t, sin2_t)[::-1])
+    assert np.max(np.abs(np.asarray(swapped[1]) - np.asarray(got[1]))) > 0.1

@@ -55,18 +55,17 @@ class Specular(Effect):
             scalar = scalar * factor
         if ctx.mueller:
             if ctx.fresnel_amplitudes is not None:
-                r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
+                entries = fresnel.matrix_entries(*ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta))
             else:
-                r_s, r_p = fresnel.amplitudes(ctx["n"] + 1j * ctx["k"], geo.cos_beta, geo.sin2_beta)
-            return fresnel.rotated_mueller(r_s, r_p, geo.cos_2eta_i, geo.sin_2eta_i, geo.cos_2eta_r, geo.sin_2eta_r, scalar)
+                entries = fresnel.interface_matrix_entries(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta)
+            return fresnel.rotated(entries, geo.mueller_basis, scalar)
         if ctx.fresnel_amplitudes is not None:
             r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             big_rs, big_rp = jnp.abs(r_s) ** 2, jnp.abs(r_p) ** 2
         else:
             big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
-        half_diff = 0.5 * scalar * (big_rs - big_rp)
-        s0 = 0.5 * scalar * (big_rs + big_rp)
-        return jnp.stack(jnp.broadcast_arrays(s0, half_diff * geo.cos_2eta_r, -half_diff * geo.sin_2eta_r, jnp.zeros_like(s0)))
+        s0, s1 = 0.5 * scalar * (big_rs + big_rp), 0.5 * scalar * (big_rs - big_rp)  # in the facet's basis
+        return fresnel.spread(s0, geo.stokes_basis[0], 1) + fresnel.spread(s1, geo.stokes_basis[1], 1)
 
 
 class Shadowing(Effect):

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import jax.numpy as jnp
+import numpy as np
 
 from .geometry import Geometry
 from .parameter import Parameter
@@ -67,9 +68,12 @@ class Context:
         Used by lobes that depolarize inside the material: only how much intensity enters
         (``row``, its first element for unpolarized light) and the state it leaves in (``column``) matter.
         """
+        # the vectors are stacked first and multiplied as whole arrays: a compiled program then computes each
+        # of their entries once, where one product per element made it compute them again in every element
+        column, row = (jnp.stack(jnp.broadcast_arrays(*v)) for v in (column, row))
         if self.mueller:
-            return jnp.stack([jnp.stack(jnp.broadcast_arrays(*(c * r for r in row))) for c in column])
-        return jnp.stack(jnp.broadcast_arrays(*(c * row[0] for c in column)))
+            return column[:, None] * row[None, :]
+        return column * row[0]
 
 
 @dataclass
@@ -79,7 +83,11 @@ class DepolarizedLobe:
     intensity: jnp.ndarray
 
     def add_to(self, total, mueller: bool):
-        return total.at[0, 0].add(self.intensity) if mueller else total.at[0].add(self.intensity)
+        # added through a one-hot (4, 4) or (4,) pattern, not written into M00 in place: an in-place update
+        # made XLA copy every element of the total out again for the likelihood's reductions
+        pattern = np.zeros((4, 4) if mueller else (4,))
+        pattern.flat[0] = 1.0
+        return total + jnp.asarray(self.intensity) * pattern.reshape(pattern.shape + (1,) * (jnp.ndim(total) - pattern.ndim))
 
 
 class Effect:

@@ -1,13 +1,16 @@
 """Fresnel reflection at a facet for a complex index N = n + ik (time dependence exp(-i w t)).
 
-Two forms, checked against each other and against ``tmm``:
+Three forms, checked against each other and against ``tmm``:
 
-* ``amplitudes``: complex r_s, r_p (needed for the full Mueller matrix, thin films).
+* ``amplitudes``: complex r_s, r_p (thin films; ``matrix_entries`` turns them into the Mueller matrix).
   Convention: the Stokes basis of each beam is (s, p, d) right-handed with the same s for the
   incident and reflected beam, so at normal incidence r_s = -r_p (a mirror).
 * ``power``: the real power reflectances R_s, R_p of paper eqs 14-19 with the corrected eq 15
   (``sin(beta) tan(beta)``; ERRATA.md).  Cheaper: it is what DOP and BRDF need for unpolarized
   incidence, so it is the hot path of an inversion.
+
+* ``interface_matrix_entries``: the Mueller matrix's entries of a bare interface in real arithmetic (the
+  full-Mueller hot path: complex arithmetic is ~3x slower compiled on a CPU).
 
 ``power_paper_eq15`` keeps the printed (wrong) eq 15 so a test can show what the typo does.
 
@@ -18,6 +21,8 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 import numpy as np
+
+from .geometry import mueller_basis
 
 
 def amplitudes(N, cos_theta, sin2_theta):
@@ -82,26 +87,63 @@ def power_paper_eq15(n, k, cos_theta, sin2_theta):
     return r_s, r_p
 
 
-def rotated_mueller(r_s, r_p, cos_2in, sin_2in, cos_2out, sin_2out, scale=1.0):
-    """``scale`` x L(eta_out) M_F L(eta_in): eq 21's non-depolarizing Mueller matrix of reflection
-    M_F = [[a, b, 0, 0], [b, a, 0, 0], [0, 0, c, d], [0, 0, -d, c]] (a, b = (|r_s|^2 +- |r_p|^2) / 2,
-    c + id = r_s r_p*) between the Stokes-basis rotations
-    L(eta) = [[1, 0, 0, 0], [0, c, s, 0], [0, -s, c, 0], [0, 0, 0, 1]] (c, s = cos 2 eta, sin 2 eta).
-
-    Written out element by element: M_F has only eight non-zero entries and L rotates one 2 x 2 block,
-    so the product costs ~30 multiplications per point where two general 4 x 4 products cost 128."""
+def matrix_entries(r_s, r_p):
+    """The four distinct entries (a, b, c, d) of eq 21's Fresnel Mueller matrix from complex amplitudes:
+    a, b = (|r_s|^2 +- |r_p|^2) / 2 and c + id = r_s r_p*."""
     rs2, rp2 = jnp.abs(r_s) ** 2, jnp.abs(r_p) ** 2
     cross = r_s * jnp.conj(r_p)
-    a, b = 0.5 * (rs2 + rp2) * scale, 0.5 * (rs2 - rp2) * scale
-    c, d = cross.real * scale, cross.imag * scale
-    a, b, c, d, ci, si, co, so = jnp.broadcast_arrays(a, b, c, d, cos_2in, sin_2in, cos_2out, sin_2out)
-    zero = jnp.zeros_like(a)
-    aco, cso, aso, cco = a * co, c * so, a * so, c * co
-    rows = ((a, b * ci, b * si, zero),
-            (b * co, aco * ci - cso * si, aco * si + cso * ci, so * d),
-            (-b * so, -aso * ci - cco * si, cco * ci - aso * si, co * d),
-            (zero, d * si, -d * ci, c))
-    return jnp.stack([jnp.stack(row) for row in rows])
+    return 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), cross.real, cross.imag
+
+
+def interface_matrix_entries(n, k, cos_theta, sin2_theta):
+    """``matrix_entries`` of a bare interface onto N = n + ik, in real arithmetic.
+
+    The same numbers as ``matrix_entries(*amplitudes(...))``, about 3x faster compiled: complex square roots
+    and divisions are slow on a CPU. N cos(theta_t) = A + iB comes from eqs 16-19 (``_a_b2``: Re and Im of the
+    principal root), then r_s = (c - A - iB) / (c + A + iB), r_p = (N^2 c - A - iB) / (N^2 c + A + iB), and all
+    four entries share one division by |D_s|^2 |D_p|^2."""
+    a, b2 = _a_b2(n, k, sin2_theta)
+    b = jnp.sqrt(b2)
+    eps_re, eps_im = n * n - k * k, 2.0 * n * k  # N^2
+    num_s_re, num_s_im = cos_theta - a, -b
+    den_s_re, den_s_im = cos_theta + a, b
+    num_p_re, num_p_im = eps_re * cos_theta - a, eps_im * cos_theta - b
+    den_p_re, den_p_im = eps_re * cos_theta + a, eps_im * cos_theta + b
+    den_s2 = den_s_re * den_s_re + den_s_im * den_s_im
+    den_p2 = den_p_re * den_p_re + den_p_im * den_p_im
+    inverse = 1.0 / (den_s2 * den_p2)
+    rs2 = (num_s_re * num_s_re + num_s_im * num_s_im) * den_p2 * inverse
+    rp2 = (num_p_re * num_p_re + num_p_im * num_p_im) * den_s2 * inverse
+    # r_s r_p* = N_s N_p* D_s* D_p / (|D_s|^2 |D_p|^2)
+    x_re, x_im = num_s_re * num_p_re + num_s_im * num_p_im, num_s_im * num_p_re - num_s_re * num_p_im
+    y_re, y_im = den_s_re * den_p_re + den_s_im * den_p_im, den_s_re * den_p_im - den_s_im * den_p_re
+    return 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), (x_re * y_re - x_im * y_im) * inverse, (x_re * y_im + x_im * y_re) * inverse
+
+
+def rotated_mueller(r_s, r_p, cos_2in, sin_2in, cos_2out, sin_2out, scale=1.0):
+    """``rotated`` for complex amplitudes and the rotation angles' cosines and sines."""
+    return rotated(matrix_entries(r_s, r_p), mueller_basis(jnp, cos_2in, sin_2in, cos_2out, sin_2out), scale)
+
+
+def rotated(entries, basis, scale=1.0):
+    """``scale`` x L(eta_out) M_F L(eta_in), eq 21's non-depolarizing Mueller matrix of reflection, from
+    M_F's entries (a, b, c, d) and ``Geometry.mueller_basis`` (4, 4, 4, ...): sum_e scale entry_e basis[e].
+
+    Each entry is broadcast over the 16 elements: XLA computes it once. Stacked element by element, as
+    before, each of the 16 elements computed the Fresnel coefficients and the facet distribution again
+    (paper+polarized_diffuse: 7 M evaluations/s; see ``Geometry.mueller_basis``)."""
+    return sum(spread(entry * scale, part, 2) for entry, part in zip(entries, basis))
+
+
+def spread(value, coefficients, lead: int):
+    """``value`` (sets x geometries, or geometries) times ``coefficients`` (``lead`` axes, then the geometry's
+    axes): ``value`` broadcast over the leading axes, so a compiled program computes it once for all of them."""
+    value = jnp.asarray(value)
+    extra = value.ndim - (np.ndim(coefficients) - lead)  # parameter-set axes the geometry does not have
+    if extra > 0:
+        shape = np.shape(coefficients)
+        coefficients = jnp.reshape(coefficients, shape[:lead] + (1,) * extra + shape[lead:])
+    return value.reshape((1,) * lead + value.shape) * coefficients
 
 
 # The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on

@@ -77,7 +77,7 @@ class Geometry:
     _TERMS = ("theta_i", "theta_r", "dphi", "wavelength_um", "k_i", "k_r", "visible", "cos_ti", "cos_tr", "h",
               "cos_beta", "sin2_beta", "sin_beta", "sin_tan_beta", "cos_alpha", "sin_alpha", "tan2_alpha", "phi_h",
               "eta_i", "eta_r", "cos_2eta_r", "sin_2eta_r", "cos_2eta_i", "sin_2eta_i", "tan_ti", "tan_tr",
-              "specular_jacobian", "sec4_alpha")
+              "specular_jacobian", "sec4_alpha", "stokes_basis", "mueller_basis")
 
     def device_terms(self) -> dict:
         """Every term as a JAX array (made once per geometry): what the compiled model receives. Computing
@@ -155,6 +155,8 @@ class Geometry:
         self.sin_2eta_r = xp.sin(2 * self.eta_r)
         self.cos_2eta_i = xp.cos(2 * self.eta_i)
         self.sin_2eta_i = xp.sin(2 * self.eta_i)
+        self.stokes_basis = stokes_basis(xp, self.cos_2eta_r, self.sin_2eta_r)
+        self.mueller_basis = mueller_basis(xp, self.cos_2eta_i, self.sin_2eta_i, self.cos_2eta_r, self.sin_2eta_r)
         self.tan_ti = xp.sqrt(1.0 - self.cos_ti**2) / self.cos_ti
         self.tan_tr = xp.sqrt(1.0 - self.cos_tr**2) / self.cos_tr
 
@@ -162,6 +164,30 @@ class Geometry:
         # distribution supplies the rest (eq 20 = D(alpha) * G * F / (4 cos ti cos tr)).
         self.specular_jacobian = 1.0 / (4.0 * self.cos_ti * self.cos_tr)
         self.sec4_alpha = self.cos_alpha**-4
+
+
+def stokes_basis(xp, cos_2out, sin_2out):
+    """(2, 4, ...): the Stokes vectors, in the macroscopic exit basis, of light that leaves a facet as
+    (1, 0, 0, 0) and as (0, 1, 0, 0) in the facet's basis: the coefficients of (S0, S1) of eq 21's reflected
+    light for unpolarized incidence."""
+    zero, one = xp.zeros_like(cos_2out), xp.ones_like(cos_2out)
+    return xp.stack([xp.stack([one, zero, zero, zero]), xp.stack([zero, cos_2out, -sin_2out, zero])])
+
+
+def mueller_basis(xp, cos_2in, sin_2in, cos_2out, sin_2out):
+    """(4, 4, 4, ...): L(eta_out) E L(eta_in) for E the four parts of a Fresnel Mueller matrix
+    M_F = a E_a + b E_b + c E_c + d E_d = [[a, b, 0, 0], [b, a, 0, 0], [0, 0, c, d], [0, 0, -d, c]], with
+    L(eta) = [[1, 0, 0, 0], [0, c, s, 0], [0, -s, c, 0], [0, 0, 0, 1]] (c, s = cos 2 eta, sin 2 eta): so
+    eq 21's matrix is sum_e entry_e x basis[e], with geometry-only coefficients computed once per data set."""
+    ci, si, co, so = xp.broadcast_arrays(cos_2in, sin_2in, cos_2out, sin_2out)
+    zero, one = xp.zeros_like(ci), xp.ones_like(ci)
+    rows = (
+        ((one, zero, zero, zero), (zero, co * ci, co * si, zero), (zero, -so * ci, -so * si, zero), (zero, zero, zero, zero)),
+        ((zero, ci, si, zero), (co, zero, zero, zero), (-so, zero, zero, zero), (zero, zero, zero, zero)),
+        ((zero, zero, zero, zero), (zero, -so * si, so * ci, zero), (zero, -co * si, co * ci, zero), (zero, zero, zero, one)),
+        ((zero, zero, zero, zero), (zero, zero, zero, so), (zero, zero, zero, co), (zero, si, -ci, zero)),
+    )
+    return xp.stack([xp.stack([xp.stack(row) for row in part]) for part in rows])
 
 
 def default_grid() -> Geometry:

@@ -8,7 +8,6 @@ Three forms, checked against each other and against ``tmm``:
 * ``power``: the real power reflectances R_s, R_p of paper eqs 14-19 with the corrected eq 15
   (``sin(beta) tan(beta)``; ERRATA.md).  Cheaper: it is what DOP and BRDF need for unpolarized
   incidence, so it is the hot path of an inversion.
-
 * ``interface_matrix_entries``: the Mueller matrix's entries of a bare interface in real arithmetic (the
   full-Mueller hot path: complex arithmetic is ~3x slower compiled on a CPU).
 

@@ -65,7 +65,7 @@ class Specular(Effect):
         else:
             big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
         s0, s1 = 0.5 * scalar * (big_rs + big_rp), 0.5 * scalar * (big_rs - big_rp)  # in the facet's basis
-        return fresnel.spread(s0, geo.stokes_basis[0], 1) + fresnel.spread(s1, geo.stokes_basis[1], 1)
+        return fresnel.combined((s0, s1), geo.stokes_basis, 1)
 
 
 class Shadowing(Effect):

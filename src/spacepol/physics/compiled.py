@@ -11,7 +11,7 @@ Three rules keep XLA fast on a CPU: terms that depend on the geometry alone are 
 (``Geometry.device_terms``) or held behind a barrier (``once``), since XLA otherwise fuses them into every
 (parameter set, geometry) element that uses them and recomputes their trigonometry there; a Stokes vector
 or Mueller matrix is assembled by broadcasting each parameter-dependent value over geometry-only bases
-(``fresnel.spread``, ``Geometry.mueller_basis``), never stacked element by element: stacked, XLA computes the
+(``fresnel.combined``, ``Geometry.mueller_basis``), never stacked element by element: stacked, XLA computes the
 value (a Fresnel coefficient, the facet distribution's exp) again in each of the 16 elements (measured:
 paper+polarized_diffuse's Mueller matrix 7 -> 28 M evaluations/s); and the additive lobes are added as whole
 arrays (a depolarized one through a one-hot pattern), not written into one in place (an in-place update made

@@ -21,8 +21,6 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from .geometry import mueller_basis
-
 
 def amplitudes(N, cos_theta, sin2_theta):
     """Complex amplitude reflection coefficients (r_s, r_p) from vacuum onto index ``N``."""
@@ -119,11 +117,6 @@ def interface_matrix_entries(n, k, cos_theta, sin2_theta):
     return 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), (x_re * y_re - x_im * y_im) * inverse, (x_re * y_im + x_im * y_re) * inverse
 
 
-def rotated_mueller(r_s, r_p, cos_2in, sin_2in, cos_2out, sin_2out, scale=1.0):
-    """``rotated`` for complex amplitudes and the rotation angles' cosines and sines."""
-    return rotated(matrix_entries(r_s, r_p), mueller_basis(jnp, cos_2in, sin_2in, cos_2out, sin_2out), scale)
-
-
 def rotated(entries, basis, scale=1.0):
     """``scale`` x L(eta_out) M_F L(eta_in), eq 21's non-depolarizing Mueller matrix of reflection, from
     M_F's entries (a, b, c, d) and ``Geometry.mueller_basis`` (4, 4, 4, ...): sum_e scale entry_e basis[e].
@@ -131,18 +124,22 @@ def rotated(entries, basis, scale=1.0):
     Each entry is broadcast over the 16 elements: XLA computes it once. Stacked element by element, as
     before, each of the 16 elements computed the Fresnel coefficients and the facet distribution again
     (paper+polarized_diffuse: 7 M evaluations/s; see ``Geometry.mueller_basis``)."""
-    return sum(spread(entry * scale, part, 2) for entry, part in zip(entries, basis))
+    return combined([entry * scale for entry in entries], basis, 2)
 
 
-def spread(value, coefficients, lead: int):
-    """``value`` (sets x geometries, or geometries) times ``coefficients`` (``lead`` axes, then the geometry's
-    axes): ``value`` broadcast over the leading axes, so a compiled program computes it once for all of them."""
-    value = jnp.asarray(value)
-    extra = value.ndim - (np.ndim(coefficients) - lead)  # parameter-set axes the geometry does not have
-    if extra > 0:
-        shape = np.shape(coefficients)
-        coefficients = jnp.reshape(coefficients, shape[:lead] + (1,) * extra + shape[lead:])
-    return value.reshape((1,) * lead + value.shape) * coefficients
+def combined(values, basis, lead: int):
+    """sum_e values[e] x basis[e]: each value (sets x geometries, or geometries) broadcast over the ``lead``
+    leading axes of its basis part (then the geometry's axes: a Stokes vector's 4, a Mueller matrix's 4 x 4),
+    so a compiled program computes it once for all of them."""
+    total = 0.0
+    for value, part in zip(values, basis):
+        value = jnp.asarray(value)
+        extra = value.ndim - (np.ndim(part) - lead)  # parameter-set axes the geometry does not have
+        if extra > 0:
+            shape = np.shape(part)
+            part = jnp.reshape(part, shape[:lead] + (1,) * extra + shape[lead:])
+        total = total + value.reshape((1,) * lead + value.shape) * part
+    return total
 
 
 # The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on

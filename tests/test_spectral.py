@@ -74,12 +74,8 @@ def test_a_cauchy_law_is_recovered_from_four_wavelengths(cauchy_fit):
     assert not p["n_cauchy_b"]["q05"] <= 0.02 <= p["n_cauchy_b"]["q95"]
 
 
-def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per_wavelength():
-    """diagnose and its changes work on a joint fit over wavelengths: the change is made to the inner
-    model, the candidates keep n@LAMBDA, and a hidden Lambertian term is named (a null set names none)."""
-    from spacepol.criticism.changes import parse
-    from spacepol.criticism.diagnose import diagnose
-
+def _two_wavelength_case():
+    """(render(model, values), base model, truth): DOP and BRDF at 0.532 and 1.064 um, n per wavelength."""
     lams = [0.532, 1.064]
     truth = {"n@0.532": 1.5, "n@1.064": 1.45, "k@0.532": 0.0, "k@1.064": 0.0, "sigma": 0.2, "ks": 0.6, "rho_l": 0.25}
     ti0, tr0 = np.meshgrid([20.0, 45.0, 65.0], np.linspace(0.0, 80.0, 9), indexing="ij")
@@ -87,17 +83,33 @@ def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per
     wl = np.repeat(lams, ti0.size)
     g = Geometry(ti, tr, np.full(ti.size, 180.0), wl)
     base = SpectralModel(Model.from_string("specular+smith"), lams)
+    rng = np.random.default_rng(4)
+    return (lambda model, values: _measured(model, values, g, rng, "synthetic two-wavelength set")), base, truth
+
+
+def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per_wavelength():
+    """diagnose and its changes work on a joint fit over wavelengths: the change is made to the inner
+    model, the candidates keep n@LAMBDA, and a hidden Lambertian term is named."""
+    from spacepol.criticism.changes import parse
+    from spacepol.criticism.diagnose import diagnose
+
+    render, base, truth = _two_wavelength_case()
     changed = parse(base, "lambertian").model
     assert isinstance(changed, SpectralModel) and changed.name == "specular+smith+lambertian"
     assert {"n@0.532", "n@1.064", "rho_l"} <= {p.name for p in changed.parameters}
-    rng = np.random.default_rng(4)
-
-    def render(model, values):
-        return _measured(model, values, g, rng, "synthetic two-wavelength set")
-
     hidden = diagnose(render(changed, truth), base, np.random.default_rng(0), candidates=["lambertian", "oxide_layer"], top=1)
     assert hidden["verdict"] == "lambertian", hidden["ranking"][:2]
     assert "n@1.064" in hidden["_base"].summary["parameters"]
+
+
+@pytest.mark.slow  # 15 s; the null half of diagnose is in the default suite on one wavelength (test_diagnose)
+def test_diagnose_over_several_wavelengths_names_nothing_on_a_null_set():
+    """Negative control of the test above: the same two-wavelength set without the Lambertian term."""
+    from spacepol.criticism.changes import parse
+    from spacepol.criticism.diagnose import diagnose
+
+    render, base, truth = _two_wavelength_case()
+    render(parse(base, "lambertian").model, truth)  # the noise draws in the order they had when one test held both
     null = diagnose(render(base, {k: v for k, v in truth.items() if k != "rho_l"}), base, np.random.default_rng(0),
                     candidates=["lambertian", "oxide_layer"], top=1)
     assert null["verdict"] == "none", null["ranking"][:2]

@@ -40,6 +40,7 @@ def test_jax_model_equals_the_previous_implementation(model_key):
         for name, new, old, scale in [
             ("stokes", stokes.stokes, CORPUS[prefix + "/stokes"], s0),
             ("dop", stokes.dop, CORPUS[prefix + "/dop"], np.max(CORPUS[prefix + "/dop"])),
+            ("dop alone (Model.dop)", model.dop(params, geometry), CORPUS[prefix + "/dop"], np.max(CORPUS[prefix + "/dop"])),
             ("mueller", full.mueller, CORPUS[prefix + "/mueller"], np.max(CORPUS[prefix + "/mueller"][0, 0])),
             ("mueller_dop", full.dop, CORPUS[prefix + "/mueller_dop"], np.max(CORPUS[prefix + "/mueller_dop"])),
         ]:

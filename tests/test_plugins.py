@@ -85,3 +85,22 @@ def test_cli_effect_option_makes_the_name_usable(tmp_path):
     listing = subprocess.run([sys.executable, "-m", "spacepol.cli", "--effect", f"{EXAMPLE}:OppositionSurge", "effects"],
                              capture_output=True, text=True)
     assert "opposition_surge" in listing.stdout and "b0 [sr^-1]" in listing.stdout
+
+
+def test_dop_alone_names_a_plugin_jax_cannot_trace():
+    """``Model.dop`` (its own compiled program) turns a plug-in written for numpy into the same one-line error
+    as ``evaluate``; a traceable plug-in gives evaluate's DOP."""
+    from spacepol.physics.effect import Effect
+
+    class NumpyGlow(Effect):
+        name = "numpy_glow"
+
+        def lobe(self, ctx):
+            return ctx.depolarized(np.exp(-np.asarray(ctx.geometry.cos_tr * ctx["ks"])))
+
+    g = Geometry(np.array([30.0, 45.0]), np.array([20.0, 60.0]), np.array([180.0, 180.0]))
+    sets = {"ks": np.array([0.3, 0.6])}
+    with pytest.raises(SpacepolError, match="numpy_glow"):
+        Model([*Model.from_string("paper").effects, NumpyGlow()]).dop(sets, g)
+    model = Model.from_string("paper")
+    assert np.array_equal(model.dop(sets, g), model.evaluate(sets, g).dop)

@@ -113,3 +113,17 @@ def test_diagnose_over_several_wavelengths_names_nothing_on_a_null_set():
     null = diagnose(render(base, {k: v for k, v in truth.items() if k != "rho_l"}), base, np.random.default_rng(0),
                     candidates=["lambertian", "oxide_layer"], top=1)
     assert null["verdict"] == "none", null["ranking"][:2]
+
+
+def test_dop_alone_equals_the_dop_of_the_whole_prediction():
+    """``dop`` (a program without the Stokes vector as output) gives evaluate's DOP, rows in the data's order,
+    for several parameter sets (padded to a bucket inside) and for one."""
+    model = SpectralModel(Model.from_string(BASE), LAMBDAS, {"n": "cauchy"})
+    data = _cauchy_set()
+    rows = np.random.default_rng(3).permutation(len(data))  # wavelengths interleaved: rows gathered back
+    g = Geometry(data.theta_i[rows], data.theta_r[rows], data.dphi[rows], data.wavelength_um[rows])
+    sets = {**{k: np.full(5, v) for k, v in TRUTH.items()}, "sigma": np.linspace(0.1, 0.5, 5)}
+    for params in (sets, TRUTH):
+        alone, whole = model.dop(params, g), model.evaluate(params, g).dop
+        assert alone.shape == whole.shape and np.allclose(alone, whole, rtol=1e-14, atol=1e-15)
+    assert not np.allclose(model.dop(sets, g)[0], model.dop(sets, g)[1])  # the sets differ: not one row repeated

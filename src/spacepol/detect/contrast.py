@@ -41,7 +41,7 @@ def target_dop_grid(model, samples: dict, scenario) -> tuple[np.ndarray, np.ndar
     geometry = Geometry(np.full(theta_r.shape, t["theta_i_deg"]), theta_r, np.full(theta_r.shape, t["dphi_deg"]))
     names = {p.name for p in model.parameters}
     params = {k: np.asarray(v, float) for k, v in samples.items() if k in names}
-    return theta_r, np.asarray(model.evaluate(params, geometry).dop)
+    return theta_r, model.dop(params, geometry)
 
 
 def _draw_target(theta_r, grid, rng, draws, fixed_theta_r=None, sample_index=None):

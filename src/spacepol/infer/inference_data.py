@@ -46,7 +46,7 @@ def model_dop(posterior: Posterior, flat_theta, draws: int = 200) -> np.ndarray:
     predicts it from its first column): (N,). Up to ``draws`` evenly thinned samples."""
     lik = posterior.likelihood
     params = posterior.model_params(flat_theta[:: max(1, len(flat_theta) // draws)])
-    return np.median(np.atleast_2d(lik.model.evaluate(params, lik.geometry, check=False).dop), axis=0)
+    return np.median(np.atleast_2d(lik.model.dop(params, lik.geometry, check=False)), axis=0)
 
 
 def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:

@@ -29,7 +29,7 @@ class PaperObjective:
 
     def __call__(self, theta):
         theta = np.atleast_2d(theta)
-        dop = self.model.evaluate(self.priors.to_params(theta), self.data.geometry, check=False).dop
+        dop = self.model.dop(self.priors.to_params(theta), self.data.geometry, check=False)
         return np.sum((dop - self.data.dop) ** 2, axis=-1) / self._norm
 
 

@@ -142,21 +142,27 @@ class SpectralModel:
                  for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
         return _assemble(parts, geometry.size, mueller)
 
+    def dop(self, params: dict, geometry: Geometry, check: bool = True) -> np.ndarray:
+        """The measured DOP alone (``Model.dop`` per wavelength), rows in the data's order."""
+        parts = [(idx, self.model.dop(self.values_at(params, j), sub, check=check))
+                 for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
+        return _gather(parts, geometry.size, lambda dop: dop)
+
     def check_plugins(self, params: dict, geometry: Geometry) -> Prediction:
         parts = [(idx, self.model.check_plugins(self.values_at(params, j), sub))
                  for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
         return _assemble(parts, geometry.size, False)
 
 
+def _gather(parts, size: int, get) -> np.ndarray:
+    """One array over all rows (in the data's order) from ``get`` of each per-wavelength output."""
+    out = np.empty(get(parts[0][1]).shape[:-1] + (size,))
+    for idx, part in parts:
+        out[..., idx] = get(part)
+    return out
+
+
 def _assemble(parts, size: int, mueller: bool) -> Prediction:
     """One Prediction over all rows from the per-wavelength ones (rows in the data's order)."""
-    first = parts[0][1]
-
-    def gather(get):
-        lead = get(first).shape[:-1]
-        out = np.empty(lead + (size,))
-        for idx, pred in parts:
-            out[..., idx] = get(pred)
-        return out
-
-    return Prediction.from_total(gather(lambda p: p.mueller if mueller else p.stokes), gather(lambda p: p.dop), mueller)
+    return Prediction.from_total(_gather(parts, size, lambda p: p.mueller if mueller else p.stokes),
+                                 _gather(parts, size, lambda p: p.dop), mueller)

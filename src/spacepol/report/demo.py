@@ -66,7 +66,7 @@ def forward_comparison(data, out: Path) -> list[str]:
         prediction = model.evaluate(params[name], data.geometry)
         columns[f"dop_{name}"] = prediction.dop
         columns[f"brdf_{name}"] = prediction.brdf
-        curves[name] = (fine, model.evaluate(params[name], fine).dop)
+        curves[name] = (fine, model.dop(params[name], fine))
         rmse = np.sqrt(np.mean((prediction.dop - data.dop) ** 2))
         lines.append(f"{name}: RMSE(DOP) {rmse:.4f} with hand-set PTFE-like parameters (not fitted)")
     write_table(out / "ptfe_forward.csv", columns, {"source": "NIST PTFE Mueller BRDF (Germer 2017)", "wavelength_um": 0.633})

@@ -24,3 +24,11 @@ def test_wide_vectors_only_on_avx512_and_never_over_the_users_choice():
     assert _flags_after_import("--xla_dump_to=/nonexistent") == ("--xla_dump_to=/nonexistent" + (f" {wide}" if has_avx512() else ""))
     # the user's own vector width wins
     assert _flags_after_import("--xla_cpu_prefer_vector_width=256") == "--xla_cpu_prefer_vector_width=256"
+
+
+def test_programs_run_on_the_calling_thread_unless_the_user_says_otherwise():
+    code = "import jax, spacepol; print(jax.config.values['jax_cpu_enable_async_dispatch'])"
+    env = {k: v for k, v in os.environ.items() if k != "JAX_CPU_ENABLE_ASYNC_DISPATCH"}
+    run = lambda env: subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout.strip()
+    assert run(env) == "False"
+    assert run({**env, "JAX_CPU_ENABLE_ASYNC_DISPATCH": "1"}) == "True"

@@ -25,9 +25,10 @@ import time
 
 import numpy as np
 
-from spacepol._runtime import configure_jax
+from spacepol._runtime import configure_jax, inline_small_calls
 
 configure_jax()
+inline_small_calls()  # as the command line runs: small calls on the calling thread
 
 from spacepol.infer.engines import optimize  # noqa: E402
 from spacepol.infer.engines.nuts import sample_nuts  # noqa: E402

@@ -23,9 +23,10 @@ import time
 
 import numpy as np
 
-from spacepol._runtime import configure_jax
+from spacepol._runtime import configure_jax, inline_small_calls
 
 configure_jax()
+inline_small_calls()  # as the command line runs: small calls on the calling thread
 
 from spacepol.infer.engines.de import run_de  # noqa: E402
 from spacepol.infer.objective import NegativeLogPosterior  # noqa: E402

@@ -26,9 +26,18 @@ def test_wide_vectors_only_on_avx512_and_never_over_the_users_choice():
     assert _flags_after_import("--xla_cpu_prefer_vector_width=256") == "--xla_cpu_prefer_vector_width=256"
 
 
-def test_programs_run_on_the_calling_thread_unless_the_user_says_otherwise():
-    code = "import jax, spacepol; print(jax.config.values['jax_cpu_enable_async_dispatch'])"
+def test_commands_run_programs_on_the_calling_thread_unless_the_user_says_otherwise():
+    """``import spacepol`` keeps JAX's default (large evaluations gain from its worker threads); the command
+    line switches before its first computation; an explicit JAX_CPU_ENABLE_ASYNC_DISPATCH wins."""
+    code = ("import sys, jax, spacepol\nfrom spacepol._runtime import inline_small_calls\n"
+            "print(jax.config.values['jax_cpu_enable_async_dispatch'])\n"
+            "if sys.argv[1] == 'cli': inline_small_calls()\n"
+            "print(jax.config.values['jax_cpu_enable_async_dispatch'])")
     env = {k: v for k, v in os.environ.items() if k != "JAX_CPU_ENABLE_ASYNC_DISPATCH"}
-    run = lambda env: subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout.strip()
-    assert run(env) == "False"
-    assert run({**env, "JAX_CPU_ENABLE_ASYNC_DISPATCH": "1"}) == "True"
+
+    def run(env, how):
+        return subprocess.run([sys.executable, "-c", code, how], env=env, capture_output=True, text=True, check=True).stdout.split()
+
+    assert run(env, "library") == ["True", "True"]
+    assert run(env, "cli") == ["True", "False"]
+    assert run({**env, "JAX_CPU_ENABLE_ASYNC_DISPATCH": "1"}, "cli") == ["True", "True"]

@@ -37,12 +37,15 @@ Measured on this machine's AMD EPYC, interleaved in one process: the paper's DOP
 evaluations/s, a fully fused DOP kernel 339 -> 481 M/s. The results are the same numbers (the
 forward-model corpus test holds at 1e-12 either way).
 
-Compiled programs run on the calling thread (``jax_cpu_enable_async_dispatch`` off, before JAX creates its
-CPU backend; an explicit JAX_CPU_ENABLE_ASYNC_DISPATCH is kept). A sampler calls the model with a few dozen
-parameter sets, and handing each call to a worker thread and waiting for it cost more than the call:
-measured, the paper's DOP for 16 sets x 84 geometries 96-153 -> 52-57 us, 256 sets 195-262 -> 148-235 us,
-4,096 sets unchanged within the machine's noise (0.66-1.28 against 0.73-1.36 ms); the 84-point posterior
-(``benchmarks/inversion_speed.py``) 3.0 -> 2.3 s, the same draws.
+Small calls on the calling thread, in the processes that make them (``inline_small_calls``: the command
+line and batch jobs; ``jax_cpu_enable_async_dispatch`` off before JAX creates its CPU backend; an explicit
+JAX_CPU_ENABLE_ASYNC_DISPATCH is kept). A sampler calls the model with a few dozen parameter sets, and
+handing each call to a worker thread and waiting for it cost more than the call: the paper's DOP for 16
+sets x 84 geometries 96-153 -> 52-57 us, the DOP likelihood over 4,096 sets (blocks of 256) 100 -> 140 M
+evaluations/s, the 84-point posterior (``benchmarks/inversion_speed.py``) 3.0 -> 2.3 s with the same draws.
+A plain ``import spacepol`` keeps JAX's default: one large evaluation loses on the calling thread (paper's
+full Mueller matrix, 4,096 x 84: 82 -> 49 M evaluations/s; DOP 400 -> 280-356), measured alternately in
+separate processes (``benchmarks/forward_speed.py --quick``).
 
 JAX's compiled programs kept on disk: every model structure and batch size is compiled once (0.2 s for the
 paper's DOP likelihood, 1-2 s for a full-Mueller one), and without a cache every command compiles them
@@ -111,13 +114,22 @@ def prefer_wide_vectors() -> None:
 _ASYNC_DISPATCH = "JAX_CPU_ENABLE_ASYNC_DISPATCH"
 
 
+def inline_small_calls() -> None:
+    """Compiled programs run on the calling thread from now on, for a process whose calls are small (an
+    inversion); effective only before JAX's first computation, a no-op after it or with an explicit
+    JAX_CPU_ENABLE_ASYNC_DISPATCH."""
+    if _ASYNC_DISPATCH in os.environ:
+        return
+    import jax
+
+    jax.config.update("jax_cpu_enable_async_dispatch", False)
+
+
 def configure_jax() -> None:
     prefer_wide_vectors()  # before JAX creates its CPU backend, which reads XLA_FLAGS once
     import jax
 
     jax.config.update("jax_enable_x64", True)
-    if _ASYNC_DISPATCH not in os.environ:
-        jax.config.update("jax_cpu_enable_async_dispatch", False)
     folder = os.environ.get("SPACEPOL_CACHE_DIR")
     if folder is None:
         base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")

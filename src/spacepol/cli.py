@@ -184,7 +184,10 @@ def main(argv=None) -> int:
         warnings.filterwarnings("ignore", category=DeprecationWarning)
         warnings.filterwarnings("ignore", module=r"jax\..*")  # e.g. an unreadable entry of the compilation cache
     from . import commands
+    from ._runtime import inline_small_calls
     from .errors import SpacepolError
+
+    inline_small_calls()  # before the first computation: a command's many small calls (samplers, optimizers)
 
     try:
         for spec in args.effect + getattr(args, "effect_after", []):

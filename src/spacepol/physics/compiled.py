@@ -119,7 +119,7 @@ def evaluate_values(effects, values: dict, batch: tuple, geometry: Geometry, mue
 
 
 def jitted(effects, fixed: dict, mueller: bool, all_visible: bool, dop_only: bool = False):
-    """The compiled evaluation ``run(traced values, geometry.device_terms()) -> (total, dop)``, or ``-> dop``
+    """The compiled evaluation ``run(traced values, geometry.device_terms()) -> (total, dop)``, or ``-> (dop,)``
     with ``dop_only`` (the Stokes vector then stays inside the fused program: for the paper's DOP, 4 x 4,096
     x 84, writing it out cost 40 % of the evaluation); ``fixed`` values (parameters nobody set) are compiled
     in as constants."""
@@ -129,7 +129,7 @@ def jitted(effects, fixed: dict, mueller: bool, all_visible: bool, dop_only: boo
         def run(traced, terms):
             total, dop = evaluate_values(effects, {**fixed, **traced}, batch_of(traced),
                                          Geometry.from_terms(terms, all_visible), mueller)
-            return dop if dop_only else (total, dop)
+            return (dop,) if dop_only else (total, dop)
 
         _JITTED[key] = jax.jit(run)
     return _JITTED[key]

@@ -77,3 +77,11 @@ def test_adding_the_named_measurements_shrinks_the_posterior_and_dop_does_not(do
     print(f"90 % width of log ks, log rho_d: DOP only {before}, + 3 BRDF {after}, + 3 DOP {control}")
     assert np.all(before / after > 3)
     assert np.all(before / control < 1.5)
+
+
+def test_a_parameter_at_its_prior_bound_is_named_and_kept_out_of_the_ridge(dop_only):
+    """At the truth k = 0 (a dielectric, the k prior's lower bound) the DOP has no first-order information on
+    k (it depends on k^2): k is reported as at its bound, not as the ridge (it tied with k_s/rho_d)."""
+    _, report = dop_only
+    assert report["ridge"]["at_prior_bound"] == ["k"] and report["ridge"]["direction"]["k"] == 0.0
+    assert any("k = 0" in f and "bound" in f for f in report["findings"])

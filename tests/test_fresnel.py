@@ -103,3 +103,30 @@ def test_real_arithmetic_entries_equal_the_complex_ones():
     # negative control: swapping s and p changes b and d
     swapped = fresnel.matrix_entries(*fresnel.amplitudes(n + 1j * k, cos_t, sin2_t)[::-1])
     assert np.max(np.abs(np.asarray(swapped[1]) - np.asarray(got[1]))) > 0.1
+
+
+def test_division_free_terms_give_the_complex_amplitudes_reflectances():
+    """``power_terms`` (sums of squares scaled so that nothing is divided; the DOP program never divides them)
+    gives |r_s|^2 and |r_p|^2 of the tmm-checked complex amplitudes as N_s / D_s and R_s N_p / D_p, over
+    metals, weak absorbers, dielectrics, n < 1 with total internal reflection, and grazing angles; the
+    denominators are positive, and beyond the critical angle R_s is exactly 1 (the diffuse lobes' 1 - R is 0)."""
+    rng = np.random.default_rng(12)
+    n = np.concatenate([rng.uniform(0.05, 5.0, 400), [1.5, 0.5, 1.0 + 1e-9, 1.405]])
+    k = np.concatenate([rng.uniform(0.0, 20.0, 200), 10.0 ** rng.uniform(-8, 0, 200), [0.0, 0.0, 0.0, 0.2289]])
+    theta = np.radians(rng.uniform(0.0, 89.99, 404))
+    cos_t, sin2_t = np.cos(theta), np.sin(theta) ** 2
+    r_s, r_p = fresnel.amplitudes(n + 1j * k, cos_t, sin2_t)
+    num_s, den_s, num_p, den_p = (np.asarray(t) for t in fresnel.power_terms(n, k, cos_t, sin2_t, np.sin(theta) * np.tan(theta)))
+    assert np.all(den_s > 0) and np.all(den_p > 0)
+    np.testing.assert_allclose(num_s / den_s, np.abs(r_s) ** 2, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(num_s / den_s * num_p / den_p, np.abs(r_p) ** 2, rtol=0, atol=1e-13)
+    # the ratio R_s + R_p over R_s - R_p, which is all the DOP needs, without the denominators
+    np.testing.assert_allclose(num_s * (den_p - num_p) / (den_s * den_p), np.abs(r_s) ** 2 - np.abs(r_p) ** 2, rtol=0, atol=1e-13)
+    n_low = rng.uniform(0.2, 0.95, 50)  # total internal reflection: every angle beyond the critical one
+    beyond = np.arcsin(n_low) + rng.uniform(1e-6, 1.0, 50) * (np.radians(89.99) - np.arcsin(n_low))
+    r_tir = np.asarray(fresnel.power(n_low, 0.0, np.cos(beyond), np.sin(beyond) ** 2, np.sin(beyond) * np.tan(beyond)))
+    assert np.all(r_tir[0] == 1.0) and np.all(r_tir[1] == 1.0)
+    # at the critical angle itself (A = B = 0) the sums are left unscaled: R_s = 1, not 0 / 0
+    s = 0.6
+    critical = fresnel.power(0.6, 0.0, np.sqrt(1 - s**2), s**2, s**2 / np.sqrt(1 - s**2))
+    assert np.isclose(float(critical[0]), 1.0, rtol=0, atol=1e-15) and np.isfinite(float(critical[1]))

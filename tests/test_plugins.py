@@ -4,6 +4,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -103,4 +104,41 @@ def test_dop_alone_names_a_plugin_jax_cannot_trace():
     with pytest.raises(SpacepolError, match="numpy_glow"):
         Model([*Model.from_string("paper").effects, NumpyGlow()]).dop(sets, g)
     model = Model.from_string("paper")
-    assert np.array_equal(model.dop(sets, g), model.evaluate(sets, g).dop)
+    np.testing.assert_allclose(model.dop(sets, g), model.evaluate(sets, g).dop, rtol=1e-14, atol=1e-15)
+
+
+def test_dop_program_divides_before_a_plugin_hook_that_sees_the_lobe():
+    """``Model.dop`` keeps the specular lobe over its Fresnel denominator (nothing in the DOP depends on a common
+    positive factor); a plug-in's modify_specular or modify_stokes must still see the true lobe, and a plug-in's
+    polarized array lobe is added at the true scale: the DOP equals evaluate's with each such plug-in."""
+    from spacepol.physics.effect import Effect
+
+    class HalfS1(Effect):  # not scale-free on its own: adds a fixed amount to S0 of the specular lobe
+        name = "half_s1"
+
+        def modify_specular(self, ctx, lobe):
+            return lobe.at[0].add(0.01)
+
+    class Analyser(Effect):
+        name = "analyser"
+
+        def modify_stokes(self, ctx, total):
+            return total.at[0].add(0.005)
+
+    class Sheen(Effect):
+        name = "sheen"
+
+        def lobe(self, ctx):
+            cos = ctx.geometry.cos_tr * jnp.ones(ctx.shape)
+            return jnp.stack([0.02 * cos, -0.01 * cos, 0.003 * cos, 0.0 * cos])
+
+    g = Geometry(np.array([30.0, 45.0, 60.0, 10.0]), np.array([20.0, 60.0, 75.0, 10.0]), np.array([180.0, 180.0, 150.0, 0.0]))
+    sets = {"ks": np.array([0.3, 0.6, 0.05]), "n": np.array([1.5, 0.9, 2.4]), "k": np.array([0.0, 3.0, 0.01])}
+    base = Model.from_string("paper")
+    dops = {}
+    for plugin in (HalfS1(), Analyser(), Sheen()):
+        model = Model([*base.effects, plugin])
+        dops[plugin.name] = model.dop(sets, g)
+        np.testing.assert_allclose(dops[plugin.name], model.evaluate(sets, g).dop, rtol=1e-13, atol=1e-15, err_msg=plugin.name)
+    for name, dop in dops.items():  # negative control: each plug-in changes the DOP
+        assert np.max(np.abs(dop - base.dop(sets, g))) > 1e-4, name

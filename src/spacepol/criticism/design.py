@@ -95,7 +95,13 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
     def ridge_sd(prec, direction):  # posterior sd along ``direction`` (in prior-sd units)
         return float(np.sqrt(direction @ scaled_covariance(prec) @ direction))
 
-    direction = np.linalg.eigh(scaled_covariance(precision))[1][:, -1]  # the largest eigenvalue's vector
+    # a parameter at a bound of its prior (a dielectric's k = 0) is left out of the ridge: the Laplace
+    # approximation does not hold there, and a model even in it (R depends on k^2) has no first-order
+    # information at the bound, so it would tie with the real ridge and win or lose it on rounding
+    at_bound = [n for n in names if _at_bound(priors.priors[n], values[n])]
+    free = [j for j, n in enumerate(names) if n not in at_bound]
+    direction = np.zeros(len(names))
+    direction[free] = np.linalg.eigh(scaled_covariance(precision)[np.ix_(free, free)])[1][:, -1]  # largest eigenvalue's
     involved = [n for n, c in zip(names, direction) if abs(c) >= 0.3]
     before = ridge_sd(precision, direction)
 
@@ -131,10 +137,20 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
         chosen.append({"measurement": pick.describe(), "observable": name, "theta_i": pick.theta_i, "theta_r": pick.theta_r,
                        "dphi": pick.dphi, "noise": pick.noise, "sd_after": sd, "shrink": before / sd})
     findings = [_words(involved, before, chosen, best_single, noise)]
+    if at_bound:
+        findings.append(f"Left out of the ridge: {', '.join(f'{n} = {values[n]:g}' for n in at_bound)}, at a bound of "
+                        f"the prior, where the Laplace approximation does not hold (a model even in a parameter has no "
+                        f"first-order information at its bound).")
     return {"parameters": names, "point": {n: float(values[n]) for n in names}, "noise": noise,
-            "ridge": {"parameters": involved, "direction": {n: float(c) for n, c in zip(names, direction)},
+            "ridge": {"parameters": involved, "at_prior_bound": at_bound, "direction": {n: float(c) for n, c in zip(names, direction)},
                       "sd_relative_to_prior": before},
             "picks": chosen, "best_single": best_single, "single": single, "findings": findings}
+
+
+def _at_bound(prior, value, tolerance=1e-9) -> bool:
+    lo, hi = (float(b) for b in prior.rescale(np.array([0.0, 1.0])))
+    width = hi - lo if np.isfinite(hi - lo) else 1.0
+    return any(np.isfinite(b) and abs(float(value) - b) <= tolerance * width for b in (lo, hi))
 
 
 def _words(involved, before, chosen, best_single, noise) -> str:

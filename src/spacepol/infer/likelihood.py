@@ -186,7 +186,8 @@ class Likelihood:
         log-likelihood (``which`` 0) or its sum per set (1); ``scalars``: ((name, value), ...) held fixed.
         Gradient samplers and optimizers compose it with their own transforms and differentiate it."""
         if self._program is None:
-            self._program = Program(self.model, self.geometry, self.needs_mueller)
+            self._program = Program(self.model, self.geometry, self.needs_mueller,
+                                    up_to_scale=all(o.scale_free for o in self.objects))
         program, fixed = self._program, dict(scalars)
         model_names = {p.name for p in self.model.parameters}
         mueller = self.needs_mueller

@@ -24,6 +24,7 @@ def wrap_deg(angle):
 
 class AoP(ColumnObservable):
     name = "aop"
+    scale_free = True
     channels = ("aop",)
     label = "AoP (deg)"
     noise = Parameter("sigma_aop_deg", "deg", LogUniform(1e-2, 30.0), 1.0,

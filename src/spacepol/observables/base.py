@@ -30,6 +30,9 @@ class Observable:
     channels: tuple[str, ...] = ()
     label: str = ""  # axis label
     needs_mueller: bool = False  # predictions need the model's full Mueller matrix
+    # predictions are ratios of the Stokes (Mueller) elements at each geometry, unchanged when all of them are
+    # multiplied by one positive number: the likelihood may then skip the model's divisions (compiled.Program)
+    scale_free: bool = False
     noise: Parameter | None = None  # the nuisance noise level of the channel group when the file gives none
     # observables whose numbers this one already holds (the normalised Mueller matrix's first column is
     # the Stokes vector, which gives DOP and AoP): by default only the fullest of them is fitted, so no

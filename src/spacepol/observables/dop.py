@@ -11,6 +11,7 @@ from .base import ColumnObservable
 
 class DOP(ColumnObservable):
     name = "dop"
+    scale_free = True
     channels = ("dop",)
     label = "DOP"
     noise = Parameter("sigma_dop", "", LogUniform(1e-4, 0.5), 0.01,

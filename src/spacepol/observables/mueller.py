@@ -39,6 +39,7 @@ def normalised(mueller) -> dict[str, np.ndarray]:
 
 class Mueller(Observable):
     name = "mueller"
+    scale_free = True
     channels = ELEMENTS
     label = "m_ij = M_ij / M_11"
     needs_mueller = True

@@ -19,6 +19,7 @@ def _normalised(stokes, row):
 
 class Stokes(Observable):
     name = "stokes"
+    scale_free = True
     channels = ("q", "u")
     label = "normalised Stokes"
     contains = ("dop", "aop")

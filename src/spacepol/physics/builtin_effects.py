@@ -7,7 +7,7 @@ import numpy as np
 
 from ..infer.priors import Uniform
 from . import facets, fresnel
-from .effect import Context, Effect
+from .effect import Context, Effect, Ratio
 from .parameter import Parameter
 from .shadowing import PAPER_CONSTANTS, paper_shadowing
 
@@ -62,6 +62,10 @@ class Specular(Effect):
         if ctx.fresnel_amplitudes is not None:
             r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             big_rs, big_rp = jnp.abs(r_s) ** 2, jnp.abs(r_p) ** 2
+        elif ctx.up_to_scale:  # R_s +- R_p = N_s (D_p +- N_p) / (D_s D_p): the denominator is kept aside
+            num_s, den_s, num_p, den_p = fresnel.power_terms(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
+            s0, s1 = 0.5 * scalar * num_s * (den_p + num_p), 0.5 * scalar * num_s * (den_p - num_p)
+            return Ratio(fresnel.stokes_rows(s0, s1, geo.stokes_basis), den_s * den_p)
         else:
             big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
         s0, s1 = 0.5 * scalar * (big_rs + big_rp), 0.5 * scalar * (big_rs - big_rp)  # in the facet's basis

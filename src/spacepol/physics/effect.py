@@ -18,6 +18,11 @@ Lobes are arrays of shape (4, *shape) (the Stokes vector for unpolarized inciden
 ``lobe.at[1:].multiply(f)`` work on both.  ``lobe`` may also return ``ctx.depolarized(f)``, a lobe that
 only scatters intensity (stored as its S0 alone).
 
+A program whose outputs do not change when every (set, geometry) element of the total is multiplied by a
+positive number (DOP, normalised Stokes parameters: ``ctx.up_to_scale``) lets the specular lobe keep its
+Fresnel denominator (a ``Ratio``) and multiplies the other lobes by it instead of dividing; hooks never see
+a Ratio (an effect that overrides ``modify_specular`` or ``modify_stokes`` gets the divided value).
+
 **Hooks are JAX code.** The model is compiled with ``jax.jit`` and evaluated for many parameter sets at
 once, so a hook computes with ``jax.numpy`` (``import jax.numpy as jnp``) and returns new arrays: JAX
 arrays are immutable (``lobe[1:] *= f`` becomes ``lobe = lobe.at[1:].multiply(f)``), and parameters are
@@ -49,6 +54,7 @@ class Context:
     facet_shape: str = "beckmann"  # or "ggx"
     anisotropic_slopes: tuple | None = None  # (sigma_x, sigma_y, psi_deg)
     fresnel_amplitudes: Callable | None = None  # (cos, sin2) -> (r_s, r_p); None = bulk N = n + ik
+    up_to_scale: bool = False  # the caller needs the total only up to a positive factor per element
     notes: dict = field(default_factory=dict)
 
     def __getitem__(self, name):
@@ -74,6 +80,30 @@ class Context:
         if self.mueller:
             return column[:, None] * row[None, :]
         return column * row[0]
+
+
+@dataclass
+class Ratio:
+    """A Stokes vector given as its rows (S0, S1, S2, S3) over a ``denominator`` > 0 per element, returned
+    only where ``ctx.up_to_scale``: the rest of the total is then multiplied by the denominator instead of
+    divided (``compiled.evaluate_values``). For the paper's DOP this removes the Fresnel divisions: 3 square
+    roots, 1 division and an exp per evaluation remain of 3, 5 and 1."""
+
+    rows: list
+    denominator: jnp.ndarray
+
+    def plus(self, lobe) -> "Ratio":
+        """This total plus a lobe of true values (an array (4, ...) or a DepolarizedLobe)."""
+        if isinstance(lobe, DepolarizedLobe):
+            return Ratio([self.rows[0] + lobe.intensity * self.denominator, *self.rows[1:]], self.denominator)
+        return Ratio([row + lobe[j] * self.denominator for j, row in enumerate(self.rows)], self.denominator)
+
+    def broadcast_rows(self, shape) -> list:
+        return [jnp.broadcast_to(row, shape) for row in self.rows]
+
+    def divided(self, shape):
+        """The true Stokes vector, (4, *shape)."""
+        return jnp.stack(self.broadcast_rows(shape)) / self.denominator
 
 
 @dataclass

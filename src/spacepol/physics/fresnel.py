@@ -62,17 +62,41 @@ def _a_b2(n, k, sin2_theta):
     return jnp.sqrt(jnp.where(above, big, small)), jnp.where(above, small, big)
 
 
+def power_terms(n, k, cos_theta, sin2_theta, sin_tan_theta):
+    """R_s = N_s / D_s and R_p = R_s N_p / D_p (eqs 14-19, corrected eq 15) as the four sums of squares,
+    without a division: (N_s, D_s, N_p, D_p), each > 0 (D) or >= 0 (N).
+
+    Each sum is eqs 16-19's (A -+ x)^2 + B^2 times A^2 + B^2's larger half ``big`` (``_a_b2``), which makes
+    every term a product: with s = sqrt(big), s A is big (above, D >= 0) or |n k| (below), and big B^2 is
+    n^2 k^2 or big^2. The common factor cancels in each ratio, and a caller that needs the reflectances only
+    up to a positive factor (DOP: ``compiled``'s up-to-scale programs) divides nowhere. ``big`` = 0 (n = k = 0,
+    or k = 0 at n = sin(theta)) leaves the sums unscaled (A = B = 0 there).
+    """
+    d = n**2 - k**2 - sin2_theta
+    nk2 = (n * k) * (n * k)
+    big = 0.5 * (jnp.sqrt(4 * nk2 + d**2) + jnp.abs(d))
+    scaled = big > 0
+    above = d >= 0
+    root = jnp.sqrt(jnp.where(scaled, big, 1.0))
+    a_root = jnp.where(scaled, jnp.where(above, big, jnp.abs(n * k)), 0.0)  # sqrt(big) A
+    b2_big = jnp.where(scaled, jnp.where(above, nk2, big * big), 0.0)  # big B^2
+    num_s = (a_root - cos_theta * root) ** 2 + b2_big
+    den_s = (a_root + cos_theta * root) ** 2 + b2_big
+    num_p = (a_root - sin_tan_theta * root) ** 2 + b2_big
+    den_p = (a_root + sin_tan_theta * root) ** 2 + b2_big
+    return num_s, den_s, num_p, den_p
+
+
 def power(n, k, cos_theta, sin2_theta, sin_tan_theta):
     """Power reflectances (R_s, R_p), eqs 14-19 with the corrected eq 15.
 
     ``sin_tan_theta`` is sin(theta) tan(theta), passed in because it is a geometry-only term.
     """
-    a, b2 = _a_b2(n, k, sin2_theta)
+    num_s, den_s, num_p, den_p = power_terms(n, k, cos_theta, sin2_theta, sin_tan_theta)
     # two divisions, not one shared one: N_s / D_s is exactly 1 where N_s = D_s (total internal reflection),
     # which keeps the transmittance 1 - R of the diffuse lobes at 0 instead of -1e-16
-    r_s = ((a - cos_theta) ** 2 + b2) / ((a + cos_theta) ** 2 + b2)
-    r_p = r_s * ((a - sin_tan_theta) ** 2 + b2) / ((a + sin_tan_theta) ** 2 + b2)
-    return r_s, r_p
+    r_s = num_s / den_s
+    return r_s, r_s * num_p / den_p
 
 
 def power_paper_eq15(n, k, cos_theta, sin2_theta):
@@ -140,6 +164,15 @@ def combined(values, basis, lead: int):
             part = jnp.reshape(part, shape[:lead] + (1,) * extra + shape[lead:])
         total = total + value.reshape((1,) * lead + value.shape) * part
     return total
+
+
+def stokes_rows(s0, s1, basis):
+    """The four rows (S0, S1, S2, S3) of ``combined((s0, s1), basis, 1)`` for ``Geometry.stokes_basis``, whose
+    structure they use: light leaving a facet as (1, 0, 0, 0) stays so, and (0, 1, 0, 0) turns into
+    (0, cos 2 eta, -sin 2 eta, 0). For a total that stays inside the program (``effect.Ratio``): there XLA
+    fuses the whole DOP into one loop only when no value is broadcast over the Stokes axis (a broadcast
+    value is computed in a loop of its own and stored), and the structural zeros cost nothing."""
+    return [s0, s1 * basis[1, 1], s1 * basis[1, 2], 0.0]
 
 
 # The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on

@@ -155,6 +155,39 @@ def numpy_paper_mueller(geo, g, n, k, sigma, ks, rho_d):
     return np.moveaxis(m, (-2, -1), (0, 1))
 
 
+def up_to_scale_versus_divided(model, sets, geometry, repeats):
+    """The DOP program as ``model.dop`` compiles it (the total up to a positive factor: no Fresnel division, the
+    Stokes rows kept apart, ``compiled.evaluate_values``) against the same hooks with every lobe divided out, both
+    compiled here without the call's conversions, in interleaved rounds."""
+    import jax
+
+    from spacepol.physics import Geometry
+    from spacepol.physics.compiled import batch_of, evaluate_values, padded
+
+    values, _ = model._resolve(sets, False)
+    traced = padded({k: v for k, v in values.items() if k in sets}, N_SETS)
+    fixed = {k: v for k, v in values.items() if k not in sets}
+    terms = geometry.device_terms()
+
+    def program(up_to_scale):
+        def dop(values, terms):
+            return evaluate_values(model.effects, {**fixed, **values}, batch_of(values),
+                                   Geometry.from_terms(terms, geometry.all_visible), False, up_to_scale)[1]
+        compiled = jax.jit(dop)
+        return lambda: compiled(traced, terms).block_until_ready()
+
+    variants = {"divided": program(False), "up to scale": program(True)}
+    rounds = {name: [] for name in variants}
+    for _ in range(repeats):
+        for name, run in variants.items():
+            rounds[name].append(timed(run, 5)[0])
+    evals = N_SETS * geometry.size
+    rates = {name: evals / statistics.median(t) / 1e6 for name, t in rounds.items()}
+    ratio = statistics.median(a / b for a, b in zip(rounds["divided"], rounds["up to scale"]))
+    print(f"  DOP program alone, {repeats} interleaved rounds: every lobe divided {rates['divided']:.0f} M/s, up to a "
+          f"positive scale (model.dop's) {rates['up to scale']:.0f} M/s; per round {ratio:.2f}x")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer repeats, no 64 x 100,000 case")
@@ -221,6 +254,8 @@ def main():
     print(f"  first call (compilation included): {compile_s:.2f} s")
     print(f"  max |DOP difference| spacepol vs numpy: {np.max(np.abs(pred.dop - dop_np)):.1e}, vs loop: "
           f"{np.max(np.abs(pred.dop[:LOOP_SETS] - loop)):.1e}; model.dop vs evaluate's: {np.max(np.abs(dop_alone - pred.dop)):.1e}")
+
+    up_to_scale_versus_divided(model, sets, geometry, repeats)
 
     cases = [(N_SETS, 84)] + ([] if args.quick else [(64, 100_000)])
     for n_sets, n_geo in cases:

@@ -54,12 +54,16 @@ def _a_b2(n, k, sin2_theta):
     sum (sqrt(C) + |D|)/2 is computed as written and the other from the product, so weak absorption
     (B^2 ~ n^2 k^2 / D, which the difference loses to rounding) keeps every digit, with one division.
     """
+    nk2, big, above = _larger_half(n, k, sin2_theta)
+    small = nk2 / jnp.where(big > 0, big, 1.0)  # big = 0 only where n = k = 0 and sin = 0
+    return jnp.sqrt(jnp.where(above, big, small)), jnp.where(above, small, big)
+
+
+def _larger_half(n, k, sin2_theta):
+    """(n^2 k^2, the larger of A^2 and B^2 = (sqrt(C) + |D|)/2, whether it is A^2 (D >= 0))."""
     d = n**2 - k**2 - sin2_theta
     nk2 = (n * k) * (n * k)
-    big = 0.5 * (jnp.sqrt(4 * nk2 + d**2) + jnp.abs(d))
-    small = nk2 / jnp.where(big > 0, big, 1.0)  # big = 0 only where n = k = 0 and sin = 0
-    above = d >= 0
-    return jnp.sqrt(jnp.where(above, big, small)), jnp.where(above, small, big)
+    return nk2, 0.5 * (jnp.sqrt(4 * nk2 + d**2) + jnp.abs(d)), d >= 0
 
 
 def power_terms(n, k, cos_theta, sin2_theta, sin_tan_theta):
@@ -72,11 +76,8 @@ def power_terms(n, k, cos_theta, sin2_theta, sin_tan_theta):
     up to a positive factor (DOP: ``compiled``'s up-to-scale programs) divides nowhere. ``big`` = 0 (n = k = 0,
     or k = 0 at n = sin(theta)) leaves the sums unscaled (A = B = 0 there).
     """
-    d = n**2 - k**2 - sin2_theta
-    nk2 = (n * k) * (n * k)
-    big = 0.5 * (jnp.sqrt(4 * nk2 + d**2) + jnp.abs(d))
+    nk2, big, above = _larger_half(n, k, sin2_theta)
     scaled = big > 0
-    above = d >= 0
     root = jnp.sqrt(jnp.where(scaled, big, 1.0))
     a_root = jnp.where(scaled, jnp.where(above, big, jnp.abs(n * k)), 0.0)  # sqrt(big) A
     b2_big = jnp.where(scaled, jnp.where(above, nk2, big * big), 0.0)  # big B^2

@@ -162,10 +162,10 @@ def up_to_scale_versus_divided(model, sets, geometry, repeats):
     import jax
 
     from spacepol.physics import Geometry
-    from spacepol.physics.compiled import batch_of, evaluate_values, padded
+    from spacepol.physics.compiled import batch_of, evaluate_values
 
     values, _ = model._resolve(sets, False)
-    traced = padded({k: v for k, v in values.items() if k in sets}, N_SETS)
+    traced = {k: v for k, v in values.items() if k in sets}  # N_SETS is a bucket size: nothing to pad
     fixed = {k: v for k, v in values.items() if k not in sets}
     terms = geometry.device_terms()
 

@@ -4,6 +4,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -142,3 +143,43 @@ def test_dop_program_divides_before_a_plugin_hook_that_sees_the_lobe():
         np.testing.assert_allclose(dops[plugin.name], model.evaluate(sets, g).dop, rtol=1e-13, atol=1e-15, err_msg=plugin.name)
     for name, dop in dops.items():  # negative control: each plug-in changes the DOP
         assert np.max(np.abs(dop - base.dop(sets, g))) > 1e-4, name
+
+
+def test_the_dop_of_one_polarized_lobe_takes_no_square_root_of_its_own():
+    """The specular lobe leaves polarized along one direction, (S1, S2) = s1 (cos 2 eta, -sin 2 eta), so the DOP
+    program takes |S_pol| = |s1| (``effect.Ratio.polarized``) instead of sqrt(S1^2 + S2^2): equal to evaluate's
+    DOP, which takes the root, out of the plane, at normal incidence, in retro-reflection, at the specular peak
+    and below the horizon; a depolarized lobe keeps the shortcut, a polarized plug-in lobe drops it (negative
+    control: that program takes the root again)."""
+    from spacepol.physics.compiled import evaluate_values
+    from spacepol.physics.effect import Effect
+
+    class Sheen(Effect):  # polarized: the sum is no longer polarized along one direction
+        name = "sheen"
+
+        def lobe(self, ctx):
+            cos = ctx.geometry.cos_tr * jnp.ones(ctx.shape)
+            return jnp.stack([0.02 * cos, -0.01 * cos, 0.003 * cos, 0.0 * cos])
+
+    rng = np.random.default_rng(11)
+    ti = np.concatenate([rng.uniform(0, 85, 40), [0.0, 30.0, 30.0, 45.0, 60.0, 95.0]])
+    tr = np.concatenate([rng.uniform(0, 85, 40), [0.0, 30.0, 30.0, 45.0, 100.0, 20.0]])
+    dphi = np.concatenate([rng.uniform(-180, 180, 40), [0.0, 0.0, 180.0, 90.0, 180.0, 180.0]])
+    g = Geometry(ti, tr, dphi)
+    assert not g.all_visible
+    sets = {"n": np.array([1.5, 0.9, 2.4, 1.0001]), "k": np.array([0.0, 3.0, 0.01, 0.0]), "sigma": np.array([0.1, 0.3, 0.5, 0.05])}
+
+    def square_roots(model):
+        values, batch = model._resolve(sets, False)
+        program = jax.make_jaxpr(lambda v: evaluate_values(model.effects, v, batch, Geometry.from_terms(g.device_terms(), False),
+                                                           False, up_to_scale=True)[1])
+        return str(program(values)).count(" sqrt ")
+
+    counts = {}
+    for spec in ("paper", "paper+lambertian", "paper+polarized_diffuse"):
+        model = Model.from_string(spec)
+        np.testing.assert_allclose(model.dop(sets, g), model.evaluate(sets, g).dop, rtol=1e-13, atol=1e-15, err_msg=spec)
+        counts[spec] = square_roots(model)
+    sheen = Model([*Model.from_string("paper").effects, Sheen()])
+    np.testing.assert_allclose(sheen.dop(sets, g), sheen.evaluate(sets, g).dop, rtol=1e-13, atol=1e-15)
+    assert counts["paper"] == counts["paper+lambertian"] == square_roots(sheen) - 1, (counts, square_roots(sheen))

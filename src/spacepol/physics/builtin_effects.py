@@ -65,7 +65,8 @@ class Specular(Effect):
         elif ctx.up_to_scale:  # R_s +- R_p = N_s (D_p +- N_p) / (D_s D_p): the denominator is kept aside
             num_s, den_s, num_p, den_p = fresnel.power_terms(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
             s0, s1 = 0.5 * scalar * num_s * (den_p + num_p), 0.5 * scalar * num_s * (den_p - num_p)
-            return Ratio(fresnel.stokes_rows(s0, s1, geo.stokes_basis), den_s * den_p)
+            # (S1, S2) = s1 (cos 2 eta, -sin 2 eta): its length is |s1|
+            return Ratio(fresnel.stokes_rows(s0, s1, geo.stokes_basis), den_s * den_p, polarized=s1)
         else:
             big_rs, big_rp = fresnel.power(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, geo.sin_tan_beta)
         s0, s1 = 0.5 * scalar * (big_rs + big_rp), 0.5 * scalar * (big_rs - big_rp)  # in the facet's basis

@@ -19,8 +19,9 @@ XLA copy all 16 elements out again for the likelihood).
 
 A program that needs the total only up to a positive factor per element (the DOP alone, the likelihood of
 DOP, AoP or normalised Stokes data: ``up_to_scale``) does less: the specular lobe keeps its Fresnel
-denominator aside (``effect.Ratio``), so the paper's DOP costs 3 square roots, 1 division and an exp per
-element instead of 3, 5 and 1, and the Stokes vector stays four separate rows: a value broadcast over the
+denominator aside (``effect.Ratio``), so the paper's DOP costs 2 square roots, 1 division and an exp per
+element instead of 3, 5 and 1 (the lobe's polarized part is known in closed form, ``Ratio.polarized``, so the
+DOP's own root goes too), and the Stokes vector stays four separate rows: a value broadcast over the
 Stokes axis is one that XLA will not fuse with its expensive producers (it computes them in loops of their
 own and stores them), while the rows let the whole DOP run as one loop.
 """
@@ -40,13 +41,17 @@ from .plugin_guard import is_plugin
 _JITTED: dict = {}
 
 
-def degree_of_polarization(stokes):
-    """|S_pol| / S0 (0 where S0 = 0): a (4, ...) numpy or JAX array, or its four rows."""
+def degree_of_polarization(stokes, polarized=None):
+    """|S_pol| / S0 (0 where S0 = 0): a (4, ...) numpy or JAX array, or its four rows; ``polarized``: a value
+    whose absolute value is |S_pol| where the caller knows one (``effect.Ratio.polarized``)."""
     xp = array_module(*stokes)
     s0 = stokes[0]
-    pol2 = stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2
-    polarized = pol2 > 0  # sqrt kept off 0, where its derivative is infinite (unpolarized retro-reflection)
-    pol = xp.where(polarized, xp.sqrt(xp.where(polarized, pol2, 1.0)), 0.0)
+    if polarized is not None:
+        pol = xp.abs(polarized)
+    else:
+        pol2 = stokes[1] ** 2 + stokes[2] ** 2 + stokes[3] ** 2
+        nonzero = pol2 > 0  # sqrt kept off 0, where its derivative is infinite (unpolarized retro-reflection)
+        pol = xp.where(nonzero, xp.sqrt(xp.where(nonzero, pol2, 1.0)), 0.0)
     lit = s0 > 0
     # |S| <= S0 holds for every lobe; rounding may push a ratio an ulp above 1.
     return xp.where(lit, xp.minimum(pol / xp.where(lit, s0, 1.0), 1.0), 0.0)
@@ -58,14 +63,23 @@ def bucket(n_sets: int) -> int:
     return 1 << max(0, (n_sets - 1).bit_length())
 
 
-def padded(values: dict, n_sets: int) -> dict:
-    """``values`` with every (n_sets, 1) array padded to ``bucket(n_sets)`` rows by repeating its last row
-    (always a valid parameter set); scalars and other shapes as they are."""
-    extra = bucket(n_sets) - n_sets if n_sets else 0
-    if not extra:
-        return values
-    return {k: np.pad(v, ((0, extra), (0, 0)), mode="edge") if np.shape(v)[:1] == (n_sets,) and np.ndim(v) == 2 else v
-            for k, v in values.items()}
+def packed(values: dict, n_sets: int) -> np.ndarray:
+    """The given values as one array, columns in ``values``' order: (bucket(n_sets), K) for parameter sets
+    ((n_sets, 1) arrays; a scalar is repeated), padded by repeating the last set (always a valid one), or (K,)
+    for scalars alone. One argument: the call then hands one buffer to the program instead of one per
+    parameter (paper's DOP, 4,096 x 84: 30 us of a 500 us call)."""
+    if not n_sets:
+        return np.array([float(v) for v in values.values()])
+    columns = np.column_stack([np.broadcast_to(np.reshape(v, (-1,)), (n_sets,)) for v in values.values()])
+    extra = bucket(n_sets) - n_sets
+    return np.pad(columns, ((0, extra), (0, 0)), mode="edge") if extra else columns
+
+
+def unpacked(names: tuple, matrix) -> dict:
+    """``packed``'s inverse inside the program: (P, 1) columns, or scalars."""
+    if jnp.ndim(matrix) == 1:
+        return {name: matrix[j] for j, name in enumerate(names)}
+    return {name: matrix[:, j, None] for j, name in enumerate(names)}
 
 
 def batch_of(values: dict) -> tuple:
@@ -96,7 +110,9 @@ def evaluate_values(effects, values: dict, batch: tuple, geometry: Geometry, mue
     Stokes parameters), so it may come back multiplied by a positive number per (set, geometry) element: the
     specular lobe then keeps its Fresnel denominator aside (``effect.Ratio``) until a hook that is not the
     base class's needs the true values. Measured on the paper's DOP, 4,096 x 84, interleaved in one process:
-    507 -> 667-758 M evaluations/s (one fused loop with 3 square roots, 1 division and 1 exp per element)."""
+    507 -> 667-758 M evaluations/s (one fused loop with 3 square roots, 1 division and 1 exp per element);
+    without the DOP's own square root (``Ratio.polarized``) 1.09x on one core (XLA single-threaded, 7 rounds),
+    1.03-1.06x on two."""
     geo = geometry
     for e in effects:
         geo = e.transform_geometry(values, geo)
@@ -140,9 +156,11 @@ def evaluate_values(effects, values: dict, batch: tuple, geometry: Geometry, mue
         total = e.modify_stokes(ctx, total)
     if isinstance(total, Ratio):  # the rows stay separate up to the DOP (a stacked array is not fused with it)
         rows = total.broadcast_rows(shape)
+        polarized = None if total.polarized is None else jnp.broadcast_to(total.polarized, shape)
         if not geo.all_visible:
             rows = [jnp.where(geo.visible, row, 0.0) for row in rows]
-        dop = degree_of_polarization(rows)
+            polarized = None if polarized is None else jnp.where(geo.visible, polarized, 0.0)
+        dop = degree_of_polarization(rows, polarized)
         total = jnp.stack(rows)
     else:
         if not geo.all_visible:
@@ -153,15 +171,17 @@ def evaluate_values(effects, values: dict, batch: tuple, geometry: Geometry, mue
     return total, dop
 
 
-def jitted(effects, fixed: dict, mueller: bool, all_visible: bool, dop_only: bool = False):
-    """The compiled evaluation ``run(traced values, geometry.device_terms()) -> (total, dop)``, or ``-> (dop,)``
+def jitted(effects, names: tuple, fixed: dict, mueller: bool, all_visible: bool, dop_only: bool = False):
+    """The compiled evaluation ``run(packed(traced values), geometry.device_terms()) -> (total, dop)``, or
+    ``-> (dop,)``
     with ``dop_only`` (the Stokes vector then stays inside the fused program: for the paper's DOP, 4 x 4,096
     x 84, writing it out cost 40 % of the evaluation); ``fixed`` values (parameters nobody set) are compiled
-    in as constants."""
-    key = (tuple(e if is_plugin(e) else type(e) for e in effects), mueller, tuple(sorted(fixed.items())), all_visible,
-           dop_only)
+    in as constants; ``names``: the traced parameters, in the packed columns' order."""
+    key = (tuple(e if is_plugin(e) else type(e) for e in effects), names, mueller, tuple(sorted(fixed.items())),
+           all_visible, dop_only)
     if key not in _JITTED:
-        def run(traced, terms):
+        def run(matrix, terms):
+            traced = unpacked(names, matrix)
             total, dop = evaluate_values(effects, {**fixed, **traced}, batch_of(traced),
                                          Geometry.from_terms(terms, all_visible), mueller, up_to_scale=dop_only)
             return (dop,) if dop_only else (total, dop)

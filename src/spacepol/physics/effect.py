@@ -87,15 +87,22 @@ class Ratio:
     """A Stokes vector given as its rows (S0, S1, S2, S3) over a ``denominator`` > 0 per element, returned
     only where ``ctx.up_to_scale``: the rest of the total is then multiplied by the denominator instead of
     divided (``compiled.evaluate_values``). For the paper's DOP this removes the Fresnel divisions: 3 square
-    roots, 1 division and an exp per evaluation remain of 3, 5 and 1."""
+    roots, 1 division and an exp per evaluation remain of 3, 5 and 1.
+
+    ``polarized``: where known in closed form, a value whose absolute value is the polarized part
+    sqrt(S1^2 + S2^2 + S3^2) of the rows (a lobe polarized along one unit direction: the specular lobe's S1
+    in the facet's basis); unpolarized lobes keep it, a polarized one drops it. It saves the DOP's square root
+    (paper's DOP: 2 square roots, 1 division and an exp per evaluation)."""
 
     rows: list
     denominator: jnp.ndarray
+    polarized: jnp.ndarray | None = None
 
     def plus(self, lobe) -> "Ratio":
         """This total plus a lobe of true values (an array (4, ...) or a DepolarizedLobe)."""
         if isinstance(lobe, DepolarizedLobe):
-            return Ratio([self.rows[0] + lobe.intensity * self.denominator, *self.rows[1:]], self.denominator)
+            return Ratio([self.rows[0] + lobe.intensity * self.denominator, *self.rows[1:]], self.denominator,
+                         self.polarized)
         return Ratio([row + lobe[j] * self.denominator for j, row in enumerate(self.rows)], self.denominator)
 
     def broadcast_rows(self, shape) -> list:

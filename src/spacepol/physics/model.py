@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ParameterError, SpacepolError, UnknownNameError
 from .arrays import array_module
-from .compiled import degree_of_polarization, evaluate_values, jitted, padded
+from .compiled import degree_of_polarization, evaluate_values, jitted, packed
 from .effect import Effect
 from .geometry import Geometry
 from .parameter import Parameter
@@ -195,8 +195,8 @@ class Model:
         traced = {k: v for k, v in values.items() if k in params}
         fixed = {k: v for k, v in values.items() if k not in params}
         n_sets = batch[0] if batch else 0
-        run = jitted(self.effects, fixed, mueller, geometry.all_visible, dop_only)
-        outputs = [np.asarray(a) for a in run(padded(traced, n_sets), geometry.device_terms())]
+        run = jitted(self.effects, tuple(traced), fixed, mueller, geometry.all_visible, dop_only)
+        outputs = [np.asarray(a) for a in run(packed(traced, n_sets), geometry.device_terms())]
         if n_sets:  # the padding off: sets are the second-to-last axis of every output
             outputs = [a[..., :n_sets, :] for a in outputs]
         return outputs

@@ -168,7 +168,10 @@ class Likelihood:
             self._jitted[key] = self._compile(*key)
         if not n_sets:
             return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
-        matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
+        if all(v.size == n_sets for _, v in columns):  # a sampler's call: one value per set of every parameter
+            matrix = np.stack([v for _, v in columns], axis=1)
+        else:
+            matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
         sizes = sorted(set(_BATCH_SIZES) | self.exact_sizes)
         rows = next((size for size in sizes if size >= n_sets), sizes[-1])
         if n_sets > rows:  # in blocks of the largest size

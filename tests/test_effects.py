@@ -212,3 +212,17 @@ def test_lambertian_reflects_its_albedo_and_is_unpolarized():
         albedo = np.trapezoid(np.trapezoid(integrand, np.radians(dphi[0]), axis=1), np.radians(tr[:, 0]))
         assert abs(albedo - 0.37) < 2e-3, (ti, albedo)
         assert np.all(pred.stokes[1:] == 0)
+
+
+def test_a_length_one_array_is_one_set_shared_by_all_wherever_it_stands():
+    """Parameter arrays of P values broadcast with length-1 arrays in any order of the model's parameters
+    (n comes before k: a length-1 n used to be taken for P = 1); lengths that do not match are named."""
+    from spacepol.errors import ParameterError
+
+    model = Model.from_string("paper")
+    g = Geometry(np.array([20.0, 40.0, 60.0]), np.array([10.0, 40.0, 70.0]), np.array([180.0, 180.0, 90.0]))
+    shared = model.dop({"n": [1.5], "k": [0.1, 0.2]}, g)
+    np.testing.assert_array_equal(shared, model.dop({"n": [1.5, 1.5], "k": [0.1, 0.2]}, g))
+    np.testing.assert_allclose(model.evaluate({"k": [0.1, 0.2], "n": [1.5]}, g).dop, shared, rtol=1e-14, atol=1e-16)
+    with pytest.raises(ParameterError, match=r"different lengths \(n: 3, k: 2\)"):
+        model.dop({"n": [1.5, 1.6, 1.7], "k": [0.1, 0.2]}, g)

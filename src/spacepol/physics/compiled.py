@@ -70,7 +70,10 @@ def packed(values: dict, n_sets: int) -> np.ndarray:
     parameter (paper's DOP, 4,096 x 84: 30 us of a 500 us call)."""
     if not n_sets:
         return np.array([float(v) for v in values.values()])
-    columns = np.column_stack([np.broadcast_to(np.reshape(v, (-1,)), (n_sets,)) for v in values.values()])
+    if all(np.shape(v) == (n_sets, 1) for v in values.values()):  # one value per set of each: as a sampler calls
+        columns = np.concatenate(list(values.values()), axis=1)
+    else:
+        columns = np.column_stack([np.broadcast_to(np.reshape(v, (-1,)), (n_sets,)) for v in values.values()])
     extra = bucket(n_sets) - n_sets
     return np.pad(columns, ((0, extra), (0, 0)), mode="edge") if extra else columns
 

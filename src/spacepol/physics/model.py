@@ -134,27 +134,30 @@ class Model:
             raise UnknownNameError(
                 f"model '{self.name}' has no parameter(s) {', '.join(unknown)} (it has: {', '.join(sorted(self._names))})"
             )
-        values = {}
+        values, arrays = {}, {}
         for p in self._parameters:
             v = params.get(p.name, p.default)
             if check:
                 p.check(v, where=f"model '{self.name}'")
-            if np.ndim(v) == 0:
+            if isinstance(v, float | int):  # the common scalar first (np.ndim would make an array of it)
                 values[p.name] = float(v)
                 continue
             v = np.asarray(v, dtype=float)
+            if v.ndim == 0:
+                values[p.name] = float(v)
+                continue
             if v.ndim > 1:
                 raise ParameterError("parameter values must be scalars or 1-d arrays of one length (one entry per parameter set)")
-            values[p.name] = v
+            values[p.name] = arrays[p.name] = v
         # P is the longest length given; a length-1 array is one set shared by all, in any position
-        lengths = {np.shape(v)[0] for v in values.values() if np.ndim(v)}
+        lengths = {v.shape[0] for v in arrays.values()}
         batch = (max(lengths),) if lengths else ()
         if lengths - {1} - set(batch):
-            given = ", ".join(f"{k}: {np.shape(v)[0]}" for k, v in values.items() if np.ndim(v))
+            given = ", ".join(f"{k}: {v.shape[0]}" for k, v in arrays.items())
             raise ParameterError(f"model '{self.name}': parameter arrays of different lengths ({given}); give each a "
                                  "scalar or one value per parameter set")
         # (P,) -> (P, 1) so parameter sets broadcast against the N geometries.
-        return {k: v[:, None] if np.ndim(v) else v for k, v in values.items()}, batch
+        return {k: arrays[k][:, None] if k in arrays else v for k, v in values.items()}, batch
 
     def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
         """Evaluate for parameter sets (scalars or arrays of length P) at N geometries.

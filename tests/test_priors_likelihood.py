@@ -124,3 +124,28 @@ def test_normalised_stokes_observables():
     assert Likelihood(no_mueller, model).observables == ["brdf", "q", "u"]  # q, u hold DOP (and AoP)
     no_mueller.stokes = None
     assert Likelihood(no_mueller, model).observables == ["dop", "brdf"]
+
+
+def test_large_batches_are_blocked_and_padded_without_changing_a_value():
+    """A call with thousands of sets goes through the compiled sizes in blocks (a remainder padded with a valid
+    set): every value equals the same set's value evaluated on its own, a length-1 column is shared by all
+    blocks, and the block sizes follow the documented rule."""
+    from spacepol.infer.likelihood import _block_rows
+    from spacepol.physics.geometry import default_grid
+
+    assert [_block_rows(n, [16, 64, 256, 1024, 4096]) for n in (5, 17, 300, 512, 800, 5000)] == [16, 64, 256, 256, 1024, 4096]
+    assert [_block_rows(n, [16, 64, 256]) for n in (300, 1000)] == [256, 256]
+    model, g = Model.from_string("paper"), default_grid()
+    data = Dataset(g.theta_i, g.theta_r, g.dphi)
+    data.dop, data.dop_err = model.evaluate({}, g).dop, np.full(g.size, 0.01)
+    lik = Likelihood(data, model)
+    assert lik.batch_sets == 4096  # 84 points: blocks above 256 allowed
+    rng = np.random.default_rng(5)
+    n_sets = 5000  # one block of 4,096 and a remainder of 904 padded to 1,024
+    sets = {"n": rng.uniform(1.2, 2.5, n_sets), "k": rng.uniform(0, 3, n_sets), "sigma": rng.uniform(0.1, 0.5, n_sets),
+            "ks": rng.uniform(0.1, 0.9, n_sets), "rho_d": np.array([0.2])}
+    total = lik.total(sets)
+    picks = [0, 4095, 4096, 4999]
+    alone = [lik.total({**{k: v[i : i + 1] for k, v in sets.items() if k != "rho_d"}, "rho_d": 0.2})[0] for i in picks]
+    np.testing.assert_allclose(total[picks], alone, rtol=1e-12)
+    assert np.all(np.isfinite(total)) and len(np.unique(total)) > n_sets // 2  # negative control: sets differ

@@ -19,14 +19,8 @@ _MIN_POINTWISE_DRAWS = 800
 
 
 def _batched(fn, flat, batch: int):
-    """fn over blocks of ``batch`` rows; the last block padded to ``batch`` rows (repeating its last row) so
-    the compiled likelihood sees one batch size, not one more to compile for the remainder."""
-    out = []
-    for i in range(0, len(flat), batch):
-        block = flat[i : i + batch]
-        short = batch - len(block) if len(flat) > batch else 0
-        out.append(fn(np.concatenate([block, np.repeat(block[-1:], short, axis=0)]) if short else block)[: len(block)])
-    return np.concatenate(out, axis=0)
+    """fn over blocks of ``batch`` rows (the compiled programs pad a remainder to a size they were compiled for)."""
+    return np.concatenate([fn(flat[i : i + batch]) for i in range(0, len(flat), batch)], axis=0)
 
 
 def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:

@@ -31,8 +31,23 @@ from ..physics.parameter import Parameter
 
 _CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
 # the only batch sizes compiled: an emcee half-ensemble, a DE generation, larger batches in blocks; every other
-# size would be a compilation of its own (0.05-1 s each, ~10 per model in a diagnose screening before this)
-_BATCH_SIZES = (16, 64, 256)
+# size would be a compilation of its own (0.05-1 s each, ~10 per model in a diagnose screening before this).
+# Blocks above 256 sets only where ``batch_sets`` allows them (small data sets): a call has a fixed cost of
+# ~50-150 us, more than 256 sets of the paper's 84-point DOP take (4,096 sets: 140 M evaluations/s in blocks
+# of 256, 274-314 in blocks of 1,024, 357-524 in one block, interleaved in one process)
+_BATCH_SIZES = (16, 64, 256, 1024, 4096)
+_ALWAYS_UP_TO = 256
+
+def _block_rows(n_sets: int, sizes: list) -> int:
+    """Sets per compiled call: the smallest compiled size that holds them all, if it is one of the small ones
+    (a call's fixed cost outweighs their padding) or padding wastes at most a quarter of it; else blocks of the
+    largest size that fits (512 sets: two calls of 256, not one of 1,024)."""
+    fit = next((size for size in sizes if size >= n_sets), None)
+    below = [size for size in sizes if size <= n_sets]
+    if fit is not None and (fit <= _ALWAYS_UP_TO or fit - n_sets <= fit // 4 or not below):
+        return fit
+    return below[-1]
+
 
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
     """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
@@ -172,14 +187,16 @@ class Likelihood:
             matrix = np.stack([v for _, v in columns], axis=1)
         else:
             matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
-        sizes = sorted(set(_BATCH_SIZES) | self.exact_sizes)
-        rows = next((size for size in sizes if size >= n_sets), sizes[-1])
-        if n_sets > rows:  # in blocks of the largest size
-            return np.concatenate([self._call(which, {**scalars, **{n: v[i : i + rows] for n, v in columns}})
-                                   for i in range(0, n_sets, rows)], axis=0)
-        if rows > n_sets:  # padded with the last set (a valid one)
-            matrix = np.concatenate([matrix, np.repeat(matrix[-1:], rows - n_sets, axis=0)])
-        return np.asarray(self._jitted[key](matrix))[:n_sets]
+        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)} | self.exact_sizes)
+        rows = _block_rows(n_sets, sizes)
+        out = []
+        for i in range(0, n_sets, rows):
+            block = matrix[i : i + rows]
+            size = next((s for s in sizes if s >= len(block)), len(block))
+            if size > len(block):  # padded with the last set (a valid one)
+                block = np.concatenate([block, np.repeat(block[-1:], size - len(block), axis=0)])
+            out.append(np.asarray(self._jitted[key](block))[: min(rows, n_sets - i)])
+        return out[0] if len(out) == 1 else np.concatenate(out, axis=0)
 
     def _compile(self, which: int, names: tuple, scalars: tuple):
         return jax.jit(self.function(which, names, scalars))

@@ -38,6 +38,7 @@ _CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at o
 _BATCH_SIZES = (16, 64, 256, 1024, 4096)
 _ALWAYS_UP_TO = 256
 
+
 def _block_rows(n_sets: int, sizes: list) -> int:
     """Sets per compiled call: the smallest compiled size that holds them all, if it is one of the small ones
     (a call's fixed cost outweighs their padding) or padding wastes at most a quarter of it; else blocks of the
@@ -236,9 +237,9 @@ class Likelihood:
             return jnp.concatenate(channel_blocks(matrix), axis=-1)
 
         def summed(matrix):
-            # the channels added element by element, then one sum over the rows: XLA then fuses the whole
-            # likelihood into one loop (summed from a concatenation, it stored every Mueller element and reduced
-            # each channel in a partitioned loop of its own: 16 + 16 hand-overs between threads per call)
+            # the channels added element by element, then one sum over the rows: one reduction (summed from a
+            # concatenation, XLA stored every Mueller element and reduced each channel in a partitioned loop of
+            # its own: 32 loops and their hand-overs between threads per call, 16 of them reductions)
             return sum(channel_blocks(matrix)).sum(axis=-1)
 
         def total(matrix):

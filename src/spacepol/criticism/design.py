@@ -148,9 +148,8 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
 
 
 def _at_bound(prior, value, tolerance=1e-9) -> bool:
-    lo, hi = (float(b) for b in prior.rescale(np.array([0.0, 1.0])))
-    width = hi - lo if np.isfinite(hi - lo) else 1.0
-    return any(np.isfinite(b) and abs(float(value) - b) <= tolerance * width for b in (lo, hi))
+    lo, hi = prior.bounds  # finite for every prior (checked when it is made)
+    return any(abs(float(value) - b) <= tolerance * (hi - lo) for b in (lo, hi))
 
 
 def _words(involved, before, chosen, best_single, noise) -> str:

@@ -25,7 +25,7 @@ from .. import observables as obs
 from ..errors import ParameterError
 from ..io.measurements import Dataset
 from ..physics.arrays import array_module
-from ..physics.compiled import Program
+from ..physics.compiled import Program, set_matrix
 from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
 
@@ -184,19 +184,17 @@ class Likelihood:
             self._jitted[key] = self._compile(*key)
         if not n_sets:
             return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
-        if all(v.size == n_sets for _, v in columns):  # a sampler's call: one value per set of every parameter
-            matrix = np.stack([v for _, v in columns], axis=1)
-        else:
-            matrix = np.column_stack([np.broadcast_to(v, (n_sets,)) for _, v in columns])
+        matrix = set_matrix([v for _, v in columns], n_sets)
         sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)} | self.exact_sizes)
         rows = _block_rows(n_sets, sizes)
         out = []
         for i in range(0, n_sets, rows):
             block = matrix[i : i + rows]
-            size = next((s for s in sizes if s >= len(block)), len(block))
-            if size > len(block):  # padded with the last set (a valid one)
-                block = np.concatenate([block, np.repeat(block[-1:], size - len(block), axis=0)])
-            out.append(np.asarray(self._jitted[key](block))[: min(rows, n_sets - i)])
+            n = len(block)
+            size = next((s for s in sizes if s >= n), n)
+            if size > n:  # padded with the last set (a valid one)
+                block = np.concatenate([block, np.repeat(block[-1:], size - n, axis=0)])
+            out.append(np.asarray(self._jitted[key](block))[:n])
         return out[0] if len(out) == 1 else np.concatenate(out, axis=0)
 
     def _compile(self, which: int, names: tuple, scalars: tuple):

@@ -70,12 +70,18 @@ def packed(values: dict, n_sets: int) -> np.ndarray:
     parameter (paper's DOP, 4,096 x 84: 30 us of a 500 us call)."""
     if not n_sets:
         return np.array([float(v) for v in values.values()])
-    if all(np.shape(v) == (n_sets, 1) for v in values.values()):  # one value per set of each: as a sampler calls
-        columns = np.concatenate(list(values.values()), axis=1)
-    else:
-        columns = np.column_stack([np.broadcast_to(np.reshape(v, (-1,)), (n_sets,)) for v in values.values()])
+    columns = set_matrix(values.values(), n_sets)
     extra = bucket(n_sets) - n_sets
     return np.pad(columns, ((0, extra), (0, 0)), mode="edge") if extra else columns
+
+
+def set_matrix(values, n_sets: int) -> np.ndarray:
+    """(n_sets, K): one column per value, each n_sets values or one shared by every set (a scalar, a length-1
+    array); stacked directly in the common case of one value per set for every column (as a sampler calls)."""
+    flat = [np.ravel(v) for v in values]
+    if all(v.size == n_sets for v in flat):
+        return np.column_stack(flat)
+    return np.column_stack([np.broadcast_to(v, (n_sets,)) for v in flat])
 
 
 def unpacked(names: tuple, matrix) -> dict:

@@ -86,8 +86,8 @@ class Context:
 class Ratio:
     """A Stokes vector given as its rows (S0, S1, S2, S3) over a ``denominator`` > 0 per element, returned
     only where ``ctx.up_to_scale``: the rest of the total is then multiplied by the denominator instead of
-    divided (``compiled.evaluate_values``). For the paper's DOP this removes the Fresnel divisions: 3 square
-    roots, 1 division and an exp per evaluation remain of 3, 5 and 1.
+    divided (``compiled.evaluate_values``). For the paper's DOP this removes the Fresnel divisions (5 divisions
+    per evaluation -> 1).
 
     ``polarized``: where known in closed form, a value whose absolute value is the polarized part
     sqrt(S1^2 + S2^2 + S3^2) of the rows (a lobe polarized along one unit direction: the specular lobe's S1

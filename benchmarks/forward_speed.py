@@ -294,21 +294,21 @@ def main():
         g = paper_shadowing(geo, *PAPER_CONSTANTS.values())
         g = np.asarray(g)
         n_evals = n_sets * n_geo
-        reps = max(1, repeats // (3 if n_geo > 1000 else 1))
+        reps = max(1, repeats // (3 if n_geo > 1000 else 1))  # numpy's 819 MB case takes 7 s a call
         t_np, m_np = timed(lambda: numpy_paper_mueller(geo, g, *(v[:, None] for v in sub.values())), reps)
         t_first = time.perf_counter()
         model.evaluate(sub, geo, mueller=True, check=False)
         first = time.perf_counter() - t_first
-        t_m, m_jax = timed(lambda: model.evaluate(sub, geo, mueller=True, check=False).mueller, reps)
+        t_m, m_jax = timed(lambda: model.evaluate(sub, geo, mueller=True, check=False).mueller, repeats)
         data = Dataset(g_ti, g_tr, g_dphi)
         data.mueller = m_jax[:, :, 0]
         data.brdf = m_jax[0, 0, 0]
         mueller_likelihood = Likelihood(data, model)
         noise = {"sigma_m_pol": 0.01, "sigma_m_lin": 0.01, "sigma_m_circ": 0.01, "sigma_brdf_rel": 0.05}
-        t_ml, _ = timed(lambda: mueller_likelihood.total({**sub, **noise}), reps)
+        t_ml, _ = timed(lambda: mueller_likelihood.total({**sub, **noise}), repeats)
         scale = np.max(np.abs(m_np[0, 0]))
         print(f"\nfull Mueller matrix of `paper`, {n_sets} sets x {n_geo:,} geometries ({n_evals:,} evaluations of 16 elements), "
-              f"median of {reps}:")
+              f"median of {reps} (numpy) or {repeats} (spacepol), each caller keeping its previous result:")
         print(f"  numpy (spacepol's heap)        {n_evals / t_np / 1e6:8.1f} M evaluations/s")
         print(f"  spacepol (JAX) evaluate        {n_evals / t_m / 1e6:8.1f} M evaluations/s  ({n_evals / t_m / (n_evals / t_np):.1f}x numpy; "
               f"first call {first:.2f} s)")

@@ -100,6 +100,10 @@ def test_real_arithmetic_entries_equal_the_complex_ones():
     got = fresnel.interface_matrix_entries(n, k, cos_t, sin2_t)
     for name, w, g in zip("abcd", want, got):
         np.testing.assert_allclose(g, w, rtol=0, atol=1e-13, err_msg=name)
+    # a lobe's scale folded into the shared division (what the Mueller program passes) scales every entry
+    scale = 10.0 ** rng.uniform(-3, 3, 404)
+    for name, w, g in zip("abcd", want, fresnel.interface_matrix_entries(n, k, cos_t, sin2_t, scale)):
+        np.testing.assert_allclose(g / scale, w, rtol=0, atol=1e-13, err_msg=f"scaled {name}")
     # negative control: swapping s and p changes b and d
     swapped = fresnel.matrix_entries(*fresnel.amplitudes(n + 1j * k, cos_t, sin2_t)[::-1])
     assert np.max(np.abs(np.asarray(swapped[1]) - np.asarray(got[1]))) > 0.1

@@ -56,9 +56,9 @@ class Specular(Effect):
         if ctx.mueller:
             if ctx.fresnel_amplitudes is not None:
                 entries = fresnel.matrix_entries(*ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta))
-            else:
-                entries = fresnel.interface_matrix_entries(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta)
-            return fresnel.rotated(entries, geo.mueller_basis, scalar)
+                return fresnel.rotated(entries, geo.mueller_basis, scalar)
+            entries = fresnel.interface_matrix_entries(ctx["n"], ctx["k"], geo.cos_beta, geo.sin2_beta, scalar)
+            return fresnel.rotated(entries, geo.mueller_basis)
         if ctx.fresnel_amplitudes is not None:
             r_s, r_p = ctx.fresnel_amplitudes(geo.cos_beta, geo.sin2_beta)
             big_rs, big_rp = jnp.abs(r_s) ** 2, jnp.abs(r_p) ** 2

@@ -20,13 +20,14 @@ cannot grow), and XLA's threads allocate from the same heap (one arena: a thread
 region of at most 64 MiB that glibc shrinks and maps again). Measured on that evaluation, interleaved:
 18 M evaluations/s as glibc starts, 44-54 without mmap'ed blocks, 106 with one arena as well. Freed memory
 at the top of the heap is given back to the system only above 2 GiB (mallopt's largest value; a quarter of
-the machine's memory where that is less, at least 1 GiB): an output larger than the trim threshold (128 MB before) was returned when freed and page-faulted
-in again on the next call. Measured (session 9, 64 sets x 100,000 geometries, an 819 MB Mueller output):
-15 -> 50 M evaluations/s, the DOP alone 85 -> 230 M/s. A fixed 1 GiB was not enough for a caller that keeps
-the previous output while the next is computed (two outputs and the program's temporaries, ~2 GB): 143,000
-page faults per call, 21 M evaluations/s; with 2 GiB or more none after the first calls, 44-47 M/s (session
-12, this 24 GB machine, alternated processes). The cost: a process that once held large arrays keeps up to
-that much freed memory (its resident size stays near its peak). An explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ /
+the machine's memory where that is less, at least 1 GiB): an output larger than the trim threshold (128 MB
+before) was returned when freed and page-faulted in again on the next call. Measured (session 9, 64 sets x
+100,000 geometries, an 819 MB Mueller output): 15 -> 50 M evaluations/s, the DOP alone 85 -> 230 M/s. A fixed
+1 GiB was not enough for a caller that keeps the previous output while the next is computed (two outputs and
+the program's temporaries, ~2 GB): 143,000 page faults per call, 21 M evaluations/s; with 2 GiB or more none
+after the first calls, 44-48 M/s (session 12, this 24 GB machine, alternated processes). The cost: a process
+that once held large arrays keeps up to that much freed memory (its resident size stays near its peak). An
+explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ /
 MALLOC_MMAP_MAX_ / MALLOC_ARENA_MAX is kept.
 
 JAX in double precision: the forward model is JAX code, and polarization near the specular peak and
@@ -65,6 +66,7 @@ import sys
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD, _M_MMAP_MAX, _M_ARENA_MAX = -1, -3, -4, -8
 _HEAP_KEPT_BYTES = 32 * 1024 * 1024  # glibc's largest allowed mmap threshold on 64-bit
 _HEAP_TRIMMED_AT_LEAST = 1024 * 1024 * 1024  # freed memory at the heap's top kept up to 1 GiB at least
+_MALLOPT_LARGEST = 2**31 - 1  # mallopt's value is a C int
 _HEAP_VARIABLES = ("MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_MAX_", "MALLOC_ARENA_MAX")
 
 
@@ -75,7 +77,7 @@ def heap_kept_bytes() -> int:
         physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     except (ValueError, OSError):  # no sysconf names: the floor
         physical = 0
-    return max(_HEAP_TRIMMED_AT_LEAST, min(physical // 4, 2**31 - 1))
+    return max(_HEAP_TRIMMED_AT_LEAST, min(physical // 4, _MALLOPT_LARGEST))
 
 
 def keep_heap() -> None:

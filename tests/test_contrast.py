@@ -100,3 +100,55 @@ def test_units_convert_and_missing_run_is_clear(tmp_path):
     assert s.instrument["pupil_area_m2"] == pytest.approx(2.544)
     r = _cli("contrast", tmp_path / "nowhere")
     assert r.returncode == 2 and "not a folder" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+SPECTRAL_TRUTH = {"n@0.532": 2.2, "k@0.532": 0.0, "n@1.064": 1.3, "k@1.064": 0.1, "sigma": 0.25, "ks": 0.6, "rho_d": 0.3}
+
+
+def _two_wavelength_run_dir(tmp_path):
+    """A two-wavelength run folder as `invert-mcmc run` now writes it: the whole model in summary.json's "spec"."""
+    run = tmp_path / "run2"
+    run.mkdir()
+    post = {k: np.full((4, 250), v) for k, v in SPECTRAL_TRUTH.items()}
+    az.from_dict(posterior=post).to_netcdf(str(run / "posterior.nc"))
+    spec = {"effects": ["specular", "shadowing", "body"], "plugins": {}, "wavelengths_um": [0.532, 1.064], "dispersion": {}}
+    (run / "summary.json").write_text(json.dumps({"model": "specular+shadowing+body", "spec": spec, "fixed": {}}))
+    return run
+
+
+def _target_dop(tmp_path, run, wavelength, *extra):
+    scenario = tmp_path / f"s{wavelength}.toml"
+    scenario.write_text(f'[target]\nwavelength_um = {wavelength}\n[[cases]]\nname = "fixed"\nzenith_deg = 40\n'
+                        'azimuth_deg = 100\nsky_dop = 0.4\ntheta_r_deg = 55\n')
+    out = tmp_path / f"c{wavelength}{''.join(extra)}"
+    r = _cli("contrast", run, "--scenario", scenario, "--draws", 200, "--out", out, *extra)
+    return r, (json.loads((out / "contrast.json").read_text()) if r.returncode == 0 else None)
+
+
+def _paper_dop(n, k):
+    values = {"n": n, "k": k, **{p: SPECTRAL_TRUTH[p] for p in ("sigma", "ks", "rho_d")}}
+    return float(Model.from_string("paper").evaluate(values, Geometry(np.array([30.0]), np.array([55.0]), np.array([180.0]))).dop[0])
+
+
+def test_contrast_of_a_two_wavelength_run_uses_that_runs_n_and_k(tmp_path):
+    """n, k at the scenario's wavelength come from the run (as measured, or interpolated between the measured
+    wavelengths), never from the model's defaults (n = 1.5, k = 0); outside the measured range one line and
+    exit 2 unless --extrapolate. The DOPs at the two wavelengths differ by far more than the tolerance."""
+    run = _two_wavelength_run_dir(tmp_path)
+    at_532, at_1064, default = _paper_dop(2.2, 0.0), _paper_dop(1.3, 0.1), _paper_dop(1.5, 0.0)
+    assert min(abs(at_532 - at_1064), abs(at_532 - default), abs(at_1064 - default)) > 0.02
+    r, report = _target_dop(tmp_path, run, 0.532)
+    assert r.returncode == 0, r.stderr
+    assert report["rows"][0]["target_dop"]["median"] == pytest.approx(at_532, rel=1e-3)
+    assert report["material"]["wavelength_um"] == 0.532 and "as measured at 0.532" in report["material"]["rule"]
+    r, report = _target_dop(tmp_path, run, 0.798)  # halfway: n 1.75, k 0.05
+    assert r.returncode == 0, r.stderr
+    assert report["rows"][0]["target_dop"]["median"] == pytest.approx(_paper_dop(1.75, 0.05), rel=1e-3)
+    assert "interpolated" in report["material"]["rule"]
+    r, report = _target_dop(tmp_path, run, 1.65)
+    assert r.returncode == 2 and "outside the run's measured 0.532-1.064 um" in r.stderr and "--extrapolate" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "c1.65").exists()
+    r, report = _target_dop(tmp_path, run, 1.65, "--extrapolate")
+    assert r.returncode == 0, r.stderr
+    assert report["rows"][0]["target_dop"]["median"] == pytest.approx(at_1064, rel=1e-3)
+    assert report["material"]["extrapolated"] is True and "nearest measured wavelength 1.064" in report["material"]["rule"]

@@ -166,6 +166,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--reading", default="corrected", choices=["corrected", "paper"],
                    help="micro-polarizer: superpixel mean 1/2 (corrected) or (1 + P)/2 (paper)")
     p.add_argument("--draws", type=_int_at_least(100), default=20000, help="posterior draws pushed through (>= 100)")
+    p.add_argument("--extrapolate", action="store_true",
+                   help="a run over several wavelengths: allow a scenario wavelength outside the measured ones (n from "
+                        "the run's dispersion law, else held at the nearest measured wavelength's value)")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/contrast")
     for p in sub.choices.values():  # --effect also after the command name, where users put it

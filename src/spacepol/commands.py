@@ -263,6 +263,10 @@ def run(args) -> int:
         from .infer.identifiability import bound_finding
 
         print(f"warning: {bound_finding(flag)}")
+    from .infer.inversion import noise_findings
+
+    for line in noise_findings(summary.get("noise", {})):
+        print(f"noise: {line}")
     d = summary["diagnostics"]
     print(f"wrote {out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, residual_trends.png, report.html "
           f"(R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")
@@ -523,7 +527,7 @@ def contrast(args) -> int:
 
     scenario = read_scenario(args.scenario) if args.scenario else default_scenario()
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "contrast")
-    report = make_contrast_report(args.run_dir, scenario, out, args.reading, args.draws, args.seed)
+    report = make_contrast_report(args.run_dir, scenario, out, args.reading, args.draws, args.seed, args.extrapolate)
     print("\n".join(table3_lines(report)))
     print(report["dominance"])
     print(f"wrote {out}/contrast.json, table3.md, contrast_histograms.png, report.html")

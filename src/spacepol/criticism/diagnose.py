@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
+from ..infer.inversion import explains
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
 from ..infer.inversion import invert
@@ -215,8 +216,11 @@ def _close(a: float, b: float) -> bool:
 
 
 def _structured(summary) -> bool:
-    """Residuals still carry structure: runs/trends flagged, or (with known noise only) a misfit above
-    the noise floor; with inferred noise chi^2 ~ 1 by construction and says nothing."""
+    """Residuals still carry structure: runs/trends flagged, or a misfit above the noise floor: with known noise
+    chi^2 > 1.5; with inferred noise that the data also measure themselves, an inferred level above 1.5x the
+    measured one; with inferred noise alone chi^2 ~ 1 by construction and says nothing."""
+    if summary.get("noise"):  # the data measure their noise: explained only within 1.5x of it
+        return not explains(summary["noise"]) or summary["residual_structure"]["structured"]
     above_floor = not inferred_noise_levels(summary) and summary["fit"]["chi2_red"] > 1.5
     return above_floor or summary["residual_structure"]["structured"]
 

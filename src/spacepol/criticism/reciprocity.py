@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..infer.measured_noise import reciprocal_pairs
 from ..physics.geometry import Geometry
 
 Q = np.diag([1.0, 1.0, -1.0, 1.0])
@@ -57,27 +58,7 @@ def _compare(forward, backward) -> dict:
             "n_geometries": int(ok.sum())}
 
 
-def data_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
-    """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
-    (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
-    and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
-    wl = np.zeros(len(data)) if data.wavelength_um is None else data.wavelength_um
-    key = {}
-    for j in range(len(data)):
-        key.setdefault(_rounded(data.theta_i[j], data.theta_r[j], data.dphi[j], wl[j], tolerance_deg), []).append(j)
-    pairs = []
-    for j in range(len(data)):
-        for k in key.get(_rounded(data.theta_r[j], data.theta_i[j], -data.dphi[j], wl[j], tolerance_deg), []):
-            if j <= k:
-                pairs.append((j, k))
-    return np.array(pairs, int).reshape(-1, 2)
-
-
-def _rounded(ti, tr, dphi, wl, tol):
-    # NIST's file stores normal incidence as 0.001 deg and normal reflection as 0: both are 0 here
-    ti, tr = (0.0 if abs(ti) < 0.01 else ti), (0.0 if abs(tr) < 0.01 else tr)
-    dphi = (dphi + 180.0) % 360.0 - 180.0
-    return (round(ti / tol), round(tr / tol), round((180.0 if abs(dphi + 180.0) < tol else dphi) / tol), round(wl * 1e4))
+data_pairs = reciprocal_pairs  # the measured geometries that are each other's swap (infer.measured_noise)
 
 
 def data_violation(data, pairs: np.ndarray | None = None) -> dict:

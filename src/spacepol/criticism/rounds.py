@@ -18,7 +18,7 @@ from .diagnose import _structured, diagnose, significant
 def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
     return {"model": summary["model"], "change": change, "delta_elpd": delta, "delta_elpd_se": se, "tied_with": list(tied),
             "alternatives": list(alternatives),
-            "fit": summary["fit"], "inferred_noise": inferred_noise_levels(summary),
+            "fit": summary["fit"], "inferred_noise": inferred_noise_levels(summary), "noise": summary.get("noise", {}),
             "residual_structure": summary["residual_structure"]["findings"],
             "structured": bool(_structured(summary)), "at_bound": summary["identifiability"].get("at_bound", [])}
 
@@ -34,7 +34,7 @@ def as_rungs(result: dict) -> list[dict]:
         rungs.append({"model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
                       "delta_elpd_se": step["delta_elpd_se"], "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"], "inferred_noise": step["inferred_noise"],
-                      "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
+                      "noise": step.get("noise", {}), "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
                       "at_bound": step["at_bound"], "_inversion": inv})
     return rungs
 
@@ -126,6 +126,8 @@ def _conclusion(path: list[dict], reports: list[dict]) -> str:
     else:
         text = f"Path: {route}; {stopped}."
     fit = fit_words(final["fit"]["chi2_red"], final["inferred_noise"])
+    if final.get("noise"):
+        fit += "; misfit (inferred / measured noise) " + ", ".join(f"{k} {v['ratio']:.2f}" for k, v in final["noise"].items())
     if final["structured"]:
         text += (f" Partly explained: the final model {final['model']} still leaves structured residuals ({fit}; "
                  + " ".join(final["residual_structure"]) + "). The structure that remains points to an effect the library "

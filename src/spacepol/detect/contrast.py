@@ -34,6 +34,39 @@ def sky_model(scenario, p_max):
     return RayleighSky(p_max)
 
 
+def scenario_wavelength_um(scenario) -> float:
+    """The wavelength the target is seen at: [target] wavelength_um, else the instrument band's centre."""
+    given = scenario.target.get("wavelength_um")
+    inst = scenario.instrument
+    return float(given) if given else 0.5 * (inst["band_low_um"] + inst["band_high_um"])
+
+
+def material_samples(model, samples: dict, scenario, summary: dict, extrapolate: bool = False):
+    """(one-wavelength model, {parameter: posterior draws} at the scenario's wavelength, contrast.json's
+    ``material`` record: the wavelength, the run's wavelengths and the rule that gave n and k there).
+
+    A run over several wavelengths gives n, k at the scenario's wavelength from its dispersion law or by linear
+    interpolation between the measured wavelengths around it (``SpectralModel.values_at_wavelength``); outside
+    the measured range only with ``extrapolate``. A one-wavelength run's draws are used as measured."""
+    from ..errors import SpacepolError
+    from ..physics.spectral import SpectralModel
+
+    lam = scenario_wavelength_um(scenario)
+    if isinstance(model, SpectralModel):
+        try:
+            params, rule = model.values_at_wavelength(samples, lam, extrapolate)
+        except SpacepolError as exc:
+            raise SpacepolError(f"contrast: the scenario's {exc} (set [target] wavelength_um in the scenario, or pass "
+                                "--extrapolate)") from None
+        return model.model, params, {"wavelength_um": lam, "measured_wavelengths_um": list(model.wavelengths),
+                                     "rule": rule, "extrapolated": not (model.wavelengths[0] <= lam <= model.wavelengths[-1])}
+    measured = (summary.get("spec") or {}).get("wavelengths_um") if isinstance(summary.get("spec"), dict) else None
+    at = f" at {measured[0]:g} um" if measured else ""
+    return model, samples, {"wavelength_um": lam, "measured_wavelengths_um": measured,
+                            "rule": f"the run's one-wavelength posterior{at} used as measured (no dispersion to "
+                                    f"{lam:g} um modelled)", "extrapolated": bool(measured) and abs(measured[0] - lam) > 1e-9}
+
+
 def target_dop_grid(model, samples: dict, scenario) -> tuple[np.ndarray, np.ndarray]:
     """DOP of every posterior sample on a theta_r grid: (theta_r (G,), dop (S, G))."""
     t = scenario.target

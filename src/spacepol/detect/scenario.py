@@ -23,7 +23,9 @@ SITE = {"lat_deg": ("deg", 43 + 8 / 60, "any"), "lon_deg": ("deg", 125 + 32 / 60
 SKY = {"model": (None, "rayleigh", "text"), "p_max_low": ("", 0.7, "fraction"), "p_max_high": ("", 0.85, "fraction"),
        "delta_deg": ("deg", 20.0, "nonnegative")}
 TARGET = {"theta_i_deg": ("deg", 30.0, "any"), "dphi_deg": ("deg", 180.0, "any"),
-          "theta_r_low_deg": ("deg", 0.0, "any"), "theta_r_high_deg": ("deg", 80.0, "any")}
+          "theta_r_low_deg": ("deg", 0.0, "any"), "theta_r_high_deg": ("deg", 80.0, "any"),
+          # where the material's n, k are taken from a run over several wavelengths; None: the band's centre
+          "wavelength_um": ("um", None, "positive")}
 INSTRUMENT = {  # Table 2 and the text around eqs 35-39
     "spot_pixels": ("", 4.0, "positive"),  # k
     "pupil_area_m2": ("m2", 2.544, "positive"),  # A_0

@@ -101,5 +101,9 @@ def fit_words(chi2_red: float, noise: dict[str, float]) -> str:
 
 
 def describe_fit(summary: dict) -> str:
-    """``fit_words`` of a run's summary."""
-    return fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary))
+    """``fit_words`` of a run's summary, and where the data measure their own noise, the misfit per group
+    (inferred / measured noise)."""
+    words = fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary))
+    if summary.get("noise"):
+        words += "; misfit (inferred / measured noise) " + ", ".join(f"{k} {v['ratio']:.2f}" for k, v in summary["noise"].items())
+    return words

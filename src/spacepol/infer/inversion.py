@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 
 from ..errors import SpacepolError
+from ..physics.model_spec import spec_of
 from .chain_file import chain_iterations, compact
 from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
@@ -97,6 +98,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     loo_result = loo(idata)
     summary = {
         "model": posterior.likelihood.model.name,
+        "spec": spec_of(posterior.likelihood.model),  # the whole model: what contrast and Result.load rebuild
         "parameters": quantiles(result),
         "diagnostics": convergence(idata, result),
         "fit": fit_statistics(posterior, result, loo_result),
@@ -111,6 +113,12 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "sampler": {k: v for k, v in result.info.items() if k != "tau"} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
+    noise = noise_ratios(posterior, summary["parameters"])
+    if noise:
+        summary["noise"] = noise
+    data_wavelengths = posterior.likelihood.data.wavelength_um
+    if summary["spec"]["wavelengths_um"] is None and data_wavelengths is not None:
+        summary["spec"]["wavelengths_um"] = [float(w) for w in np.unique(data_wavelengths)]
     derived = getattr(posterior.likelihood.model, "derived", None)
     if derived is not None:  # values a dispersion law implies per wavelength (n@0.633 from A and B)
         values = derived(posterior.priors.to_params(result.flat_samples()))
@@ -123,3 +131,35 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
                                      "structured": structure.structured()}
     return Inversion(posterior, result, idata, summary, loo_result, ident)
+
+
+EXPLAINED_NOISE_RATIO = 1.5  # a model explains the data when no inferred noise level exceeds the measured one by more
+
+
+def noise_ratios(posterior: Posterior, parameters: dict) -> dict:
+    """summary.json's ``noise``: {noise parameter: {"inferred" (posterior median), "measured", "ratio", ...}} for
+    the levels the data measure themselves. The ratio is the misfit the model hides in its inferred noise."""
+    out = {}
+    for name, measured in getattr(posterior, "measured_noise", {}).items():
+        if name in parameters:
+            inferred = float(parameters[name]["median"])
+            out[name] = {"inferred": inferred, "measured": measured.value, "ratio": inferred / measured.value,
+                         **{k: v for k, v in measured.to_json().items() if k != "measured"}}
+    return out
+
+
+def noise_findings(noise: dict) -> list[str]:
+    """One sentence per noise group: misfit = inferred / measured, and whether the model explains the data."""
+    out = []
+    for name, v in noise.items():
+        verdict = ("within the measurement's noise" if v["ratio"] <= EXPLAINED_NOISE_RATIO
+                   else "NOT explained: the model hides structure in this noise")
+        out.append(f"{name}: misfit = inferred {v['inferred']:.3g} / measured {v['measured']:.3g} "
+                   f"(+- {v['standard_error']:.2g}, {v['n_differences']} {v['source']} differences) = {v['ratio']:.2f}: {verdict}")
+    return out
+
+
+def explains(noise: dict) -> bool | None:
+    """True when every inferred noise level is within EXPLAINED_NOISE_RATIO of the measured one; None without
+    measured noise."""
+    return None if not noise else all(v["ratio"] <= EXPLAINED_NOISE_RATIO for v in noise.values())

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .likelihood import Likelihood
+from .measured_noise import measure
 from .prior_set import PriorSet
 
 
@@ -21,11 +22,22 @@ class Posterior:
                 f"{priors.ndim} free parameters ({', '.join(priors.names)})"
             )
 
+    measured_noise: dict = {}  # {noise parameter: MeasuredNoise} the data measure themselves (set by build)
+
     @classmethod
-    def build(cls, data, model, prior_overrides=None, observables=None, robust=False, where="priors"):
+    def build(cls, data, model, prior_overrides=None, observables=None, robust=False, where="priors",
+              noise_floor: bool = True):
+        """Likelihood and priors of ``model`` on ``data``. Where the data measure their own noise (reciprocal
+        pairs, repeated geometries: ``measured_noise``), an inferred noise level's prior starts at the measured
+        level's floor, so that no fit claims less noise than the measurement shows (``noise_floor=False``
+        keeps the default priors; a prior file's own prior for the level always wins)."""
         likelihood = Likelihood(data, model, observables=observables, robust=robust)
-        priors = PriorSet(model.parameters + likelihood.nuisance, prior_overrides, where=where)
+        measured = measure(likelihood)
+        nuisance = [_floored(p, measured[p.name]) if noise_floor and p.name in measured and p.name not in (prior_overrides or {})
+                    else p for p in likelihood.nuisance]
+        priors = PriorSet(model.parameters + nuisance, prior_overrides, where=where)
         posterior = cls(likelihood, priors)
+        posterior.measured_noise = measured
         posterior.check_support(where)
         return posterior
 
@@ -84,3 +96,14 @@ class Posterior:
 
     def __call__(self, theta):
         return self.log_prob(theta)
+
+
+def _floored(parameter, measured):
+    """``parameter`` (a noise level) with its prior's lower bound raised to the measured level's floor."""
+    import dataclasses
+
+    prior = parameter.prior
+    lower = min(max(prior.lower, measured.floor), 0.5 * prior.upper)
+    return dataclasses.replace(parameter, prior=type(prior)(lower, prior.upper),
+                               description=f"{parameter.description}; at least {lower:.3g}, the floor of the noise "
+                                           f"the data measure themselves ({measured.source})")

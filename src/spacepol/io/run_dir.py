@@ -10,8 +10,9 @@ import numpy as np
 from ..errors import SpacepolError
 
 
-def load_run(run_dir) -> tuple[str, dict[str, np.ndarray], dict]:
-    """(model spec, {parameter: flat samples}, summary) of a run folder."""
+def load_run(run_dir) -> tuple[dict | str, dict[str, np.ndarray], dict]:
+    """(model spec, {parameter: flat samples}, summary) of a run folder. The spec is the whole model
+    (``physics.model_spec``); a folder written before specs were stored gives the model's name."""
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise SpacepolError(f"{run_dir}: not a folder (give the --out folder of `invert-mcmc run`)")
@@ -34,4 +35,4 @@ def load_run(run_dir) -> tuple[str, dict[str, np.ndarray], dict]:
     samples = {name: np.asarray(post[name]).reshape(-1) for name in post.data_vars}
     for name, fixed in summary.get("fixed", {}).items():
         samples.setdefault(name, float(fixed))
-    return model, samples, summary
+    return summary.get("spec", model), samples, summary

@@ -10,6 +10,7 @@ from . import facets, fresnel
 from .effect import Context, Effect, Ratio
 from .parameter import Parameter
 from .shadowing import PAPER_CONSTANTS, paper_shadowing
+from .volume import Volume, VolumeRayleigh
 
 
 class Specular(Effect):
@@ -385,6 +386,6 @@ class Lambertian(Effect):
 
 BUILTIN_EFFECTS = (
     Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
-    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian, Subsurface,
+    Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian, Subsurface, Volume, VolumeRayleigh,
 )
 PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

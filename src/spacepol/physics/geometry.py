@@ -77,7 +77,7 @@ class Geometry:
     _TERMS = ("theta_i", "theta_r", "dphi", "wavelength_um", "k_i", "k_r", "visible", "cos_ti", "cos_tr", "h",
               "cos_beta", "sin2_beta", "sin_beta", "sin_tan_beta", "cos_alpha", "sin_alpha", "tan2_alpha", "phi_h",
               "eta_i", "eta_r", "cos_2eta_r", "sin_2eta_r", "cos_2eta_i", "sin_2eta_i", "tan_ti", "tan_tr",
-              "specular_jacobian", "sec4_alpha", "stokes_basis", "mueller_basis")
+              "specular_jacobian", "sec4_alpha", "stokes_basis", "mueller_basis", "s_in", "s_out")
 
     def device_terms(self) -> dict:
         """Every term as a JAX array (made once per geometry): what the compiled model receives. Computing
@@ -142,6 +142,7 @@ class Geometry:
         # A source or detector with negative theta sits at azimuth + 180 deg.
         s_in = s_in * xp.where(ti < 0, -1.0, 1.0)[..., None]
         s_out = s_out * xp.where(tr < 0, -1.0, 1.0)[..., None]
+        self.s_in, self.s_out = s_in, s_out
         # Facet s vector: normal to the plane containing k_i, h (and k_r).
         s_f = xp.cross(h, k_i)
         s_f_norm = xp.linalg.norm(s_f, axis=-1, keepdims=True)

@@ -17,6 +17,7 @@ class Registry:
     def __init__(self):
         self._effects: dict[str, type[Effect]] = {}
         self._entry_points_loaded = False
+        self.sources: dict[str, str] = {}  # plug-in effect name -> where it came from ("path.py:Name", "entry point X")
 
     def register(self, cls: type[Effect]) -> type[Effect]:
         if not (inspect.isclass(cls) and issubclass(cls, Effect)):
@@ -36,7 +37,7 @@ class Registry:
         self._entry_points_loaded = True
         for ep in entry_points(group="spacepol.effects"):
             try:
-                self.register(ep.load())
+                self.sources[self.register(ep.load()).name] = f"entry point {ep.name}"
             except Exception as exc:  # a broken plug-in must not hide the built-ins
                 raise SpacepolError(f"entry point '{ep.name}' ({ep.value}) of group spacepol.effects: {exc}") from exc
 
@@ -63,7 +64,9 @@ class Registry:
             raise SpacepolError(f"--effect '{spec}': importing {path} failed{at}: {type(exc).__name__}: {exc}") from None
         if not hasattr(module, attr):
             raise SpacepolError(f"--effect '{spec}': {path} defines no '{attr}'")
-        return self.register(getattr(module, attr))
+        cls = self.register(getattr(module, attr))
+        self.sources[cls.name] = f"{path.resolve()}:{attr}"
+        return cls
 
     def names(self) -> list[str]:
         self._load_entry_points()

@@ -106,6 +106,52 @@ class SpectralModel:
                 out[f"{name}@{label}"] = self.values_at(params, j)[name]
         return out
 
+    def values_at_wavelength(self, params: dict, wavelength_um: float, extrapolate: bool = False) -> tuple[dict, str]:
+        """The inner model's parameters at any wavelength, and the rule that gave them, in words.
+
+        Inside the measured range a dispersion law is evaluated where the run had one, and every other
+        spectral parameter is interpolated linearly in wavelength between the two measured wavelengths around
+        it (per posterior draw). Outside it the call fails unless ``extrapolate``: then the law is evaluated
+        beyond its data, and a parameter without a law keeps its value at the nearest measured wavelength."""
+        lam = float(wavelength_um)
+        lo, hi = self.wavelengths[0], self.wavelengths[-1]
+        outside = lam < lo * (1 - 1e-9) or lam > hi * (1 + 1e-9)
+        if outside and not extrapolate:
+            raise ParameterError(f"wavelength {lam:g} um lies outside the run's measured {lo:g}-{hi:g} um "
+                                 "(choose one inside it, or extrapolate explicitly)")
+        out = {k: params[k] for k in self.shared if k in params}
+        rules = []
+        grid = np.array(self.wavelengths)
+        for name in self.spectral:
+            if self.dispersion.get(name) == "cauchy":
+                out[name] = np.asarray(params["n_cauchy_a"]) + np.asarray(params["n_cauchy_b"]) / lam**2
+                rules.append(f"{name} from the run's Cauchy law at {lam:g} um"
+                             + (f" (extrapolated beyond {lo:g}-{hi:g} um)" if outside else ""))
+                continue
+            keys = [f"{name}@{label}" for label in self.labels]
+            if not all(k in params for k in keys):
+                continue
+            values = np.stack(np.broadcast_arrays(*(np.asarray(params[k], float) for k in keys)), axis=-1)
+            if outside:
+                nearest = int(np.argmin(np.abs(grid - lam)))
+                out[name] = values[..., nearest]
+                rules.append(f"{name} held at its value at the nearest measured wavelength {self.labels[nearest]} um "
+                             f"(extrapolated from {lo:g}-{hi:g} um, no dispersion law)")
+                continue
+            j = int(np.clip(np.searchsorted(grid, lam) - 1, 0, len(grid) - 2)) if len(grid) > 1 else 0
+            if len(grid) == 1 or abs(grid[j] - lam) < 1e-9 * lam:
+                out[name] = values[..., j]
+                rules.append(f"{name} as measured at {self.labels[j]} um")
+            elif abs(grid[j + 1] - lam) < 1e-9 * lam:
+                out[name] = values[..., j + 1]
+                rules.append(f"{name} as measured at {self.labels[j + 1]} um")
+            else:
+                w = (lam - grid[j]) / (grid[j + 1] - grid[j])
+                out[name] = (1 - w) * values[..., j] + w * values[..., j + 1]
+                rules.append(f"{name} interpolated linearly in wavelength between {self.labels[j]} and "
+                             f"{self.labels[j + 1]} um")
+        return out, "; ".join(rules)
+
     def _groups(self, geometry: Geometry):
         key = id(geometry)
         if key not in self._geometries:

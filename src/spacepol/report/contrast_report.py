@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..errors import SpacepolError
 from ..io.atomic import atomic_path, save_figure, write_json
 from . import html as H
 from .sky_figures import contrast_histograms
@@ -34,31 +35,39 @@ def dominance_paragraph(report: dict) -> str:
     return " ".join(parts)
 
 
-def make_contrast_report(run_dir, scenario, out: Path, reading: str = "corrected", draws: int = 20000, seed: int = 0) -> dict:
-    """Load the run's posterior, propagate it through the scenario, write the files; returns contrast.json's content."""
+def make_contrast_report(run_dir, scenario, out: Path, reading: str = "corrected", draws: int = 20000, seed: int = 0,
+                         extrapolate: bool = False) -> dict:
+    """Load the run's posterior, propagate it through the scenario, write the files; returns contrast.json's content.
+    ``extrapolate``: allow a scenario wavelength outside a multi-wavelength run's measured range."""
     import numpy as np
 
-    from ..detect.contrast import propagate
+    from ..detect.contrast import material_samples, propagate
     from ..detect.paper_table3 import recompute
     from ..io.run_dir import load_run
-    from ..physics.model import build_model
+    from ..physics.model_spec import model_from_spec
 
     spec, samples, summary = load_run(run_dir)
-    model = build_model(spec)
-    report = propagate(model, samples, scenario, np.random.default_rng(seed), draws=draws, reading=reading)
+    if isinstance(spec, str) and any("@" in name for name in samples):
+        raise SpacepolError(f"{run_dir}: the run has per-wavelength parameters but its summary.json stores only the model's "
+                            "name; run it again with this version to store the whole model")
+    model = model_from_spec(spec, str(run_dir))
+    inner, params, material = material_samples(model, samples, scenario, summary, extrapolate)
+    report = propagate(inner, params, scenario, np.random.default_rng(seed), draws=draws, reading=reading)
+    report["material"] = material
     report["paper_table3"] = recompute(scenario.instrument)
     report["model"] = spec
     report["seed"] = seed
-    write_contrast_report(report, out, str(run_dir), assumptions(summary, scenario))
+    write_contrast_report(report, out, str(run_dir), assumptions(summary, scenario, material))
     return report
 
 
-def assumptions(summary: dict, scenario) -> list[str]:
+def assumptions(summary: dict, scenario, material: dict | None = None) -> list[str]:
     t, sky_ = scenario.target, scenario.sky
     return [
         f"Target DOP from the posterior of {summary['model']} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "
         f"theta_r uniform in [{t['theta_r_low_deg']:g}, {t['theta_r_high_deg']:g}] deg (the paper's Figure 9 range), "
         "unless a case fixes theta_r_deg.",
+        f"Material at {material['wavelength_um']:g} um: {material['rule']}." if material else
         "The material's posterior is used as measured; no dispersion to the 1.5-1.8 um band is modelled.",
         f"Sky DOP from the {sky_['model']} model with P_max uniform in [{sky_['p_max_low']:g}, {sky_['p_max_high']:g}] "
         "(a clear sky peaks near 0.7-0.8), sun from astropy for the scenario's site and time.",

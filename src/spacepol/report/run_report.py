@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..infer.inference_data import for_storage
+from ..infer.inversion import EXPLAINED_NOISE_RATIO, noise_findings
 from ..io.atomic import atomic_path, save_figure, write_json, write_text
 from . import html as H
 from ..criticism.residuals import analyse
@@ -110,6 +111,9 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
                         + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
          + H.bullets(s["residual_structure"]["findings"])
+         + (H.paragraph("Noise the data measure themselves (reciprocal pairs, repeated geometries) against the noise the "
+                        "fit inferred; a model explains the data only where the ratio is at most "
+                        f"{EXPLAINED_NOISE_RATIO:g}:") + H.bullets(noise_findings(s["noise"])) if s.get("noise") else "")
          + H.image(png("fit.png"), "Data, posterior median and 90 % band of the prediction, "
                    "per observable (rows) and incidence angle (columns).")
          + H.image(png("residuals.png"), "Standardised residuals; dotted lines at +-2.")

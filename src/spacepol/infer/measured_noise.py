@@ -1,0 +1,142 @@
+"""The measurement noise a data set shows by itself, without any model: from geometries measured twice, and for
+the Mueller matrix and the BRDF from reciprocal pairs (source and detector swapped, where a passive sample gives
+M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q, Q = diag(1, 1, -1, 1), and the same BRDF).
+
+Each pair gives one difference per channel whose variance is twice the noise variance; the noise of a channel
+group (the nuisance parameter that holds it: ``sigma_m_lin``, ``sigma_brdf_rel``, ...) is estimated from all of
+its differences robustly, sigma = 1.4826 median|d| / sqrt(2), so that a few pairs spoiled by alignment (near
+the specular peak) do not inflate it. Its relative standard error is about 1.17 / sqrt(K) for K differences
+(the median absolute deviation's efficiency, 37 %, of the standard deviation's 1 / sqrt(2K)).
+
+How it is used (``infer.posterior``): the inferred noise level of the group may not fall below
+``MeasuredNoise.floor`` (the estimate less two standard errors), and every report compares the inferred level
+with the measured one: their ratio is the misfit the model hides in its noise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..observables.mueller import ELEMENTS, index
+
+_Q = np.array([1.0, 1.0, -1.0, 1.0])
+_MAD_TO_SIGMA = 1.482602218505602
+_MAD_RELATIVE_SE = 1.166  # sqrt(1 / (2 x 0.3675)): relative standard error of a MAD-based sigma, times sqrt(K)
+MIN_DIFFERENCES = 20  # fewer differences measure nothing worth a floor
+
+
+@dataclass(frozen=True)
+class MeasuredNoise:
+    """The noise level ``value`` of the channels held by nuisance parameter ``parameter``, measured from
+    ``n_differences`` differences of repeated or reciprocal measurements (``source``)."""
+
+    parameter: str
+    value: float
+    n_differences: int
+    source: str
+
+    @property
+    def standard_error(self) -> float:
+        return _MAD_RELATIVE_SE * self.value / np.sqrt(self.n_differences)
+
+    @property
+    def floor(self) -> float:
+        """The lowest noise level the data allow: the estimate less two standard errors (never below half of it)."""
+        return max(self.value - 2.0 * self.standard_error, 0.5 * self.value)
+
+    def to_json(self) -> dict:
+        return {"measured": self.value, "standard_error": self.standard_error, "floor": self.floor,
+                "n_differences": self.n_differences, "source": self.source}
+
+
+def _rounded(ti, tr, dphi, wl, tol):
+    # NIST's file stores normal incidence as 0.001 deg and normal reflection as 0: both are 0 here
+    ti, tr = (0.0 if abs(ti) < 0.01 else ti), (0.0 if abs(tr) < 0.01 else tr)
+    dphi = (dphi + 180.0) % 360.0 - 180.0
+    return (round(ti / tol), round(tr / tol), round((180.0 if abs(dphi + 180.0) < tol else dphi) / tol), round(wl * 1e4))
+
+
+def _keys(data, tolerance_deg):
+    wl = np.zeros(len(data)) if data.wavelength_um is None else data.wavelength_um
+    return wl, {j: _rounded(data.theta_i[j], data.theta_r[j], data.dphi[j], wl[j], tolerance_deg) for j in range(len(data))}
+
+
+def reciprocal_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
+    (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
+    and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
+    wl, keys = _keys(data, tolerance_deg)
+    rows: dict = {}
+    for j, key in keys.items():
+        rows.setdefault(key, []).append(j)
+    pairs = []
+    for j in range(len(data)):
+        for k in rows.get(_rounded(data.theta_r[j], data.theta_i[j], -data.dphi[j], wl[j], tolerance_deg), []):
+            if j <= k:
+                pairs.append((j, k))
+    return np.array(pairs, int).reshape(-1, 2)
+
+
+def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b), a < b, of geometries measured more than once (each later row with the first)."""
+    _, keys = _keys(data, tolerance_deg)
+    first: dict = {}
+    pairs = []
+    for j, key in keys.items():
+        if key in first:
+            pairs.append((first[key], j))
+        else:
+            first[key] = j
+    return np.array(pairs, int).reshape(-1, 2)
+
+
+def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, list]:
+    """{noise parameter: [arrays of differences]} for every inferred channel of the likelihood."""
+    out: dict[str, list] = {}
+    observed = likelihood.observed
+    for channel, y in observed.items():
+        parameter = likelihood.noise_parameter(channel)
+        if parameter is None:  # the file gives errors: nothing to infer
+            continue
+        owner = likelihood.observable_of(channel)
+        diffs = out.setdefault(parameter, [])
+        if len(pairs_repeated):
+            a, b = pairs_repeated.T
+            diffs.append(np.asarray(owner.residual(channel, y[b], y[a], True), float))
+        if not len(pairs_reciprocal):
+            continue
+        if owner.name == "mueller":
+            i, j = index(channel)
+            mirror = observed[f"m{j + 1}{i + 1}"] if i != j else y
+            a, b = pairs_reciprocal.T
+            keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
+            diffs.append(y[b[keep]] - _Q[i] * _Q[j] * mirror[a[keep]])
+        elif owner.name == "brdf":
+            a, b = pairs_reciprocal[pairs_reciprocal[:, 0] != pairs_reciprocal[:, 1]].T
+            diffs.append(np.asarray(owner.residual(channel, y[b], y[a], likelihood.inferred(channel)), float))
+    return out
+
+
+def measure(likelihood) -> dict[str, MeasuredNoise]:
+    """{noise parameter: MeasuredNoise} for the likelihood's inferred noise levels that the data measure
+    themselves (at least ``MIN_DIFFERENCES`` finite differences)."""
+    data = likelihood.data
+    reciprocal, repeated = reciprocal_pairs(data), repeated_pairs(data)
+    if not len(reciprocal) and not len(repeated):
+        return {}
+    source = " and ".join(s for s, p in (("reciprocal pairs", reciprocal), ("repeated geometries", repeated)) if len(p))
+    out = {}
+    for parameter, parts in _differences(likelihood, reciprocal, repeated).items():
+        d = np.concatenate([np.ravel(p) for p in parts]) if parts else np.empty(0)
+        d = d[np.isfinite(d)]
+        if d.size < MIN_DIFFERENCES:
+            continue
+        value = _MAD_TO_SIGMA * float(np.median(np.abs(d))) / np.sqrt(2.0)
+        if value > 0:
+            out[parameter] = MeasuredNoise(parameter, value, int(d.size), source)
+    return out
+
+
+__all__ = ["ELEMENTS", "MeasuredNoise", "measure", "reciprocal_pairs", "repeated_pairs"]

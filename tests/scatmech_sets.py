@@ -65,3 +65,62 @@ def mueller_set(kind: str, noise_m: float = 0.005, noise_brdf: float = 0.02, see
     data.dop_err = np.full(g.size, noise_m)
     data.source = f"SCATMECH render ({kind})"
     return data
+
+
+# PTFE-like: a rough dielectric of index 1.35, a weak facet lobe, strong multiple scattering under the surface and,
+# in the "volume" sets, light scattered once inside (First_Diffuse_BRDF_Model, Code-Whitney over Henyey-Greenstein)
+PTFE_LIKE = {"n": 1.35, "k": 0.0, "sigma": 0.3, "ks": 0.15, "rho_s": 0.9,
+             "w_vol": 0.8, "g_vol": 0.2, "pl_vol": 0.5, "pc_vol": 0.3, "s_vol": 0.0}
+_LOG_ABSORPTION = -1.38629  # SCATMECH's albedo 1 / (1 + exp(la)) = 0.8 (w_vol), to SCATMECH's 6 digits
+
+
+def ptfe_like_geometry(size: int = 280) -> Geometry:
+    """About ``size`` of the geometries NIST measured PTFE at (theta_i 0-75 deg, theta_r to 80 deg, 192 azimuths;
+    data/ptfe), every k-th row, plus the rows of its reciprocal pairs (so the set measures its own noise)."""
+    from spacepol.infer.measured_noise import reciprocal_pairs
+    from spacepol.io.measurements import read_measurements
+    from spacepol.paths import bundled
+
+    data = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
+    pairs = reciprocal_pairs(data)
+    rows = np.union1d(np.arange(0, len(data), max(1, len(data) // size)), pairs.ravel())
+    return Geometry(data.theta_i[rows], data.theta_r[rows], data.dphi[rows])
+
+
+def ptfe_like_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float = 0.02, seed: int = 0,
+                  truth: dict = PTFE_LIKE) -> Dataset:
+    """Facets (weight ks) + SCATMECH's subsurface multiple scattering + (``volume``) first-order volume
+    scattering, at ``ptfe_like_geometry``; the 15 normalised elements with absolute noise ``noise_m`` and the
+    BRDF with relative noise ``noise_brdf``, both given in the file as errors."""
+    from pySCATMECH.brdf import BRDF_Model
+
+    m = truth
+    substrate = f"({m['n']},{m['k']})"
+    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
+    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                                        "reflectance": "Table_Reflectance", "reflectance.table": m["rho_s"]})
+    once = BRDF_Model("First_Diffuse_BRDF_Model", {
+        "lambda": 0.633, "substrate": substrate, "type": 0, "phase_function": "CodeWhitney_Phase_Function",
+        "phase_function.phase_function": "Henyey_Greenstein_Phase_Function", "phase_function.phase_function.g": m["g_vol"],
+        "phase_function.plmax": m["pl_vol"], "phase_function.pcmax": m["pc_vol"], "phase_function.s": m["s_vol"],
+        "phase_function.log_absorption": _LOG_ABSORPTION, "phase_function.log_scattering": 0})
+    g = ptfe_like_geometry()
+    mueller = np.empty((4, 4, g.size))
+    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
+        args = np.radians([ti, tr, 180.0 - dphi])
+        M = m["ks"] * np.array(facets.MuellerBRDF(*args)) + np.array(under.MuellerBRDF(*args))
+        if volume:
+            M = M + np.array(once.MuellerBRDF(*args))
+        mueller[:, :, j] = M
+    rng = np.random.default_rng(seed)
+    normalised = mueller / mueller[0, 0]
+    noisy = normalised + noise_m * rng.standard_normal(normalised.shape)
+    noisy[0, 0] = 1.0
+    brdf = mueller[0, 0] * (1 + noise_brdf * rng.standard_normal(g.size))
+    data = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=np.full(g.size, 0.633))
+    data.mueller = np.clip(noisy, -1, 1) * brdf
+    data.mueller_err = np.full((4, 4, g.size), noise_m)
+    data.brdf, data.brdf_err = brdf, noise_brdf * mueller[0, 0]
+    data.source = f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)"
+    return data

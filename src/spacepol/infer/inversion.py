@@ -110,9 +110,11 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         "priors": posterior.priors.describe(),
         "fixed": {k: float(v) for k, v in posterior.priors.fixed.items()},
         "map": result.best,
-        "sampler": {k: v for k, v in result.info.items() if k != "tau"} | {"tau": result.info.get("tau")},
+        "sampler": {k: v for k, v in result.info.items() if k not in ("tau", "start_search")} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
+    if "start_search" in result.info:  # the modes the start-point searches found (infer.modes)
+        summary["start_search"] = result.info["start_search"]
     noise = noise_ratios(posterior, summary["parameters"])
     if noise:
         summary["noise"] = noise

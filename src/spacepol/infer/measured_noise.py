@@ -95,7 +95,7 @@ def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
 def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, list]:
     """{noise parameter: [arrays of differences]} for every inferred channel of the likelihood."""
     out: dict[str, list] = {}
-    observed = likelihood.observed
+    observed = likelihood.observed()
     for channel, y in observed.items():
         parameter = likelihood.noise_parameter(channel)
         if parameter is None:  # the file gives errors: nothing to infer

@@ -52,45 +52,77 @@ def _internal_direction(k_out, n, into: bool):
     return (sign * kx / n, sign * ky / n, sign * mu), mu
 
 
-def _matrix(rows):
-    """(4, 4, *shape) from nested rows of arrays or numbers, broadcast to one shape."""
-    flat = jnp.broadcast_arrays(*[jnp.asarray(v, dtype=float) for row in rows for v in row])
-    return jnp.stack(flat).reshape((4, 4) + flat[0].shape)
+# Stokes S_k = E^dagger sigma_k E in each beam's (s, p) basis (S1 > 0 for s; S3 = 2 Im(E_s* E_p), the sign of
+# ``fresnel.matrix_entries``), so the Mueller matrix of a Jones matrix J is M_kl = tr(sigma_k J sigma_l J^dagger) / 2
+_SIGMA = np.array([[[1, 0], [0, 1]], [[1, 0], [0, -1]], [[0, 1], [1, 0]], [[0, -1j], [1j, 0]]])
+_JONES_TO_MUELLER = 0.5 * np.einsum("kab,lcd->klbcad", _SIGMA, _SIGMA)  # M_kl = Re sum C J[b, c] conj(J[a, d])
 
 
-def _apply(matrix, x):
-    """matrix @ x over the leading axes: x is a Mueller matrix (4, 4, ...) or a Stokes vector (4, ...)."""
-    if x.ndim == matrix.ndim:
-        return jnp.einsum("ij...,jk...->ik...", matrix, x)
-    return jnp.einsum("ij...,j...->i...", matrix, x)
+def jones_mueller(jones):
+    """The Mueller matrix (4 x 4 nested lists of arrays) of a Jones matrix given as 2 x 2 nested lists of (real,
+    imaginary) pairs: every product J[b, c] conj(J[a, d]) is formed once, in real arithmetic (complex arithmetic
+    compiles ~3x slower on a CPU), and each element sums the few that its constant coefficients select."""
+    products = {}
+
+    def product(b, c, a, d):
+        if (b, c, a, d) not in products:
+            (xr, xi), (yr, yi) = jones[b][c], jones[a][d]
+            products[b, c, a, d] = (xr * yr + xi * yi, xi * yr - xr * yi)
+        return products[b, c, a, d]
+
+    rows = []
+    for k in range(4):
+        row = []
+        for l in range(4):
+            total = 0.0
+            for index in zip(*np.nonzero(np.abs(_JONES_TO_MUELLER[k, l]) > 1e-12)):
+                coefficient = _JONES_TO_MUELLER[k, l][index]
+                re, im = product(*index)
+                if abs(coefficient.real) > 1e-12:
+                    total = total + coefficient.real * re
+                if abs(coefficient.imag) > 1e-12:
+                    total = total - coefficient.imag * im
+            row.append(total)
+        rows.append(row)
+    return rows
 
 
-def _real_jones_mueller(j11, j12, j21, j22):
-    """Mueller matrix of a real Jones matrix [[j11, j12], [j21, j22]] (a change of basis between two beams'
-    bases, a rotation or a reflection). Independent of the sign convention of S3: M44 is the determinant."""
-    h = 0.5
-    return _matrix((
-        (h * (j11**2 + j12**2 + j21**2 + j22**2), h * (j11**2 - j12**2 + j21**2 - j22**2), j11 * j12 + j21 * j22, 0.0),
-        (h * (j11**2 + j12**2 - j21**2 - j22**2), h * (j11**2 - j12**2 - j21**2 + j22**2), j11 * j12 - j21 * j22, 0.0),
-        (j11 * j21 + j12 * j22, j11 * j21 - j12 * j22, j11 * j22 + j12 * j21, 0.0),
-        (0.0, 0.0, 0.0, j11 * j22 - j12 * j21),
-    ))
+def _times(a, b, columns: int):
+    """a @ b for 4 x 4 nested lists (b: ``columns`` leading columns), skipping structural zeros (plain 0.0)."""
+    out = []
+    for i in range(4):
+        row = []
+        for j in range(columns):
+            terms = [a[i][k] * b[k][j] for k in range(4) if not _is_zero(a[i][k]) and not _is_zero(b[k][j])]
+            row.append(sum(terms[1:], terms[0]) if terms else 0.0)
+        out.append(row)
+    return out
 
 
-def _transmission(n, k, cos_t, mu_internal):
-    """Mueller matrix of Fresnel transmission from vacuum into N = n + ik at external angle theta (cosine
-    ``cos_t``), in the (s, p) bases outside and inside, as a power ratio (the field's Mueller matrix times
-    n mu' / cos(theta)): its M11 is the transmittance 1 - R for k = 0. By reciprocity the same matrix carries
-    light out at that angle."""
-    N = n + 1j * k
+def _is_zero(x) -> bool:
+    return isinstance(x, float) and x == 0.0
+
+
+def _transmission_amplitudes(n, k, cos_t):
+    """Fresnel amplitude transmission (t_s, t_p) from vacuum into N = n + ik at external angle theta, each as
+    (real, imaginary), in real arithmetic: t_s = 2 c / (c + N cos(theta_t)), t_p = 2 N c / (N^2 c + N cos(theta_t)),
+    with N cos(theta_t) = A + iB the principal root (``fresnel._a_b2``)."""
     sin2 = 1.0 - cos_t * cos_t
-    root = jnp.sqrt(N * N - sin2)  # N cos(theta_t), principal branch
-    t_s = 2.0 * cos_t / (cos_t + root)
-    t_p = 2.0 * N * cos_t / (N * N * cos_t + root)
-    a, b, c, d = fresnel.matrix_entries(t_s, t_p)
-    power = n * mu_internal / cos_t
-    return _matrix(((power * a, power * b, 0.0, 0.0), (power * b, power * a, 0.0, 0.0),
-                    (0.0, 0.0, power * c, power * d), (0.0, 0.0, -power * d, power * c)))
+    a, b2 = fresnel._a_b2(n, k, sin2)
+    b = jnp.sqrt(b2)
+    ds_re, ds_im = cos_t + a, b
+    inv_s = 2.0 * cos_t / (ds_re * ds_re + ds_im * ds_im)
+    t_s = (ds_re * inv_s, -ds_im * inv_s)
+    eps_re, eps_im = n * n - k * k, 2.0 * n * k
+    dp_re, dp_im = eps_re * cos_t + a, eps_im * cos_t + b
+    inv_p = 2.0 * cos_t / (dp_re * dp_re + dp_im * dp_im)
+    # (n + ik) / (dp_re + i dp_im)
+    t_p = ((n * dp_re + k * dp_im) * inv_p, (k * dp_re - n * dp_im) * inv_p)
+    return t_s, t_p
+
+
+def _scaled(pair, factor):
+    return (pair[0] * factor, pair[1] * factor)
 
 
 def henyey_greenstein(g, cos_theta):
@@ -103,7 +135,8 @@ def code_whitney(phase, cos_theta, linear, circular, asymmetry=0.0):
     perpendicular) basis, over any scalar phase function ``phase``: M12 = M21 = linear (cos^2 - 1)/(1 + cos^2),
     M33 = M44 = 2 cos / (1 + cos^2), M43 = -M34 = circular (1 - cos_f^2) / (1 + cos_f^2) with the angle of the
     circular term skewed, Theta_f = Theta (1 + 3.13 s exp(-7 Theta / pi)); all times ``phase``. With
-    linear = 1, circular = 0 and the phase function 3 (1 + cos^2) / (16 pi) it is the Rayleigh matrix."""
+    linear = 1, circular = 0 and the phase function 3 (1 + cos^2) / (16 pi) it is the Rayleigh matrix. Returns
+    4 x 4 nested lists (0.0 where structurally zero)."""
     c = jnp.clip(cos_theta, -1.0 + _TINY, 1.0 - _TINY)
     theta = jnp.arccos(c)
     cf = jnp.cos(theta * (1.0 + 3.13 * asymmetry * jnp.exp(-7.0 * theta / np.pi)))
@@ -111,8 +144,8 @@ def code_whitney(phase, cos_theta, linear, circular, asymmetry=0.0):
     m12 = linear * (c * c - 1.0) / a
     m33 = 2.0 * c / a
     m43 = circular * (1.0 - cf * cf) / (1.0 + cf * cf)
-    return _matrix(((phase, phase * m12, 0.0, 0.0), (phase * m12, phase, 0.0, 0.0),
-                    (0.0, 0.0, phase * m33, -phase * m43), (0.0, 0.0, phase * m43, phase * m33)))
+    p12, p33, p43 = phase * m12, phase * m33, phase * m43
+    return [[phase, p12, 0.0, 0.0], [p12, phase, 0.0, 0.0], [0.0, 0.0, p33, -p43], [0.0, 0.0, p43, p33]]
 
 
 def rayleigh_phase(cos_theta):
@@ -121,9 +154,13 @@ def rayleigh_phase(cos_theta):
 
 
 def single_scattering(ctx: Context, albedo, phase_matrix):
-    """The lobe of light scattered once under the interface: ``phase_matrix(cos Theta)`` -> (4, 4, ...) in the
-    scattering plane's (parallel, perpendicular) basis; (4, 4, ...) with ``ctx.mueller``, else the Stokes
-    vector for unpolarized light (the matrix's first column)."""
+    """The lobe of light scattered once under the interface: ``phase_matrix(cos Theta)`` -> 4 x 4 nested lists in the
+    scattering plane's (parallel, perpendicular) basis; (4, 4, ...) with ``ctx.mueller``, else the Stokes vector
+    for unpolarized light (the matrix's first column).
+
+    The way in (transmission, then the change of basis into the scattering plane) and the way out are each one
+    Jones matrix, J_in = R_in diag(t_s, t_p) and J_out = diag(t_s, t_p) R_out, so M = A_out P A_in with A the
+    Mueller matrices of the two; the power factors n mu' / cos(theta) of the transmissions go into the scale."""
     geo = ctx.geometry
     n, k = ctx["n"], ctx["k"]
     k_i, k_r = _components(geo.k_i), _components(geo.k_r)
@@ -137,14 +174,22 @@ def single_scattering(ctx: Context, albedo, phase_matrix):
     inverse = 1.0 / jnp.sqrt(jnp.maximum(norm2, 1e-18))
     perp = tuple(jnp.where(degenerate, s, p * inverse) for p, s in zip(perp, s_in))
     par_in, par_out = _cross(d_in, perp), _cross(d_out, perp)
-    into_plane = _real_jones_mueller(_dot(par_in, s_in), _dot(par_in, p_in), _dot(perp, s_in), _dot(perp, p_in))
-    out_of_plane = _real_jones_mueller(_dot(s_out, par_out), _dot(s_out, perp), _dot(p_out, par_out), _dot(p_out, perp))
-    scale = albedo / (n * n * (mu_in + mu_out))
-    enter = _transmission(n, k, geo.cos_ti, mu_in)
-    x = enter if ctx.mueller else enter[:, 0]
-    for step in (into_plane, phase_matrix(_dot(d_in, d_out)), out_of_plane, _transmission(n, k, geo.cos_tr, mu_out)):
-        x = _apply(step, x)
-    return x * scale
+    # changes of basis (real Jones matrices): (s_in, p_in) -> (par_in, perp) and (par_out, perp) -> (s_out, p_out)
+    into = ((_dot(par_in, s_in), _dot(par_in, p_in)), (_dot(perp, s_in), _dot(perp, p_in)))
+    out_of = ((_dot(s_out, par_out), _dot(s_out, perp)), (_dot(p_out, par_out), _dot(p_out, perp)))
+    t_in = _transmission_amplitudes(n, k, geo.cos_ti)
+    t_out = _transmission_amplitudes(n, k, geo.cos_tr)
+    j_in = [[_scaled(t_in[c], into[r][c]) for c in range(2)] for r in range(2)]
+    j_out = [[_scaled(t_out[r], out_of[r][c]) for c in range(2)] for r in range(2)]
+    power = (n * mu_in / geo.cos_ti) * (n * mu_out / geo.cos_tr)
+    scale = albedo * power / (n * n * (mu_in + mu_out))
+    a_in = jones_mueller(j_in)
+    columns = 4 if ctx.mueller else 1
+    inner = _times(phase_matrix(_dot(d_in, d_out)), [row[:columns] for row in a_in], columns)
+    total = _times(jones_mueller(j_out), inner, columns)
+    flat = jnp.broadcast_arrays(*[jnp.asarray(v, dtype=float) * scale for row in total for v in row])
+    stacked = jnp.stack(flat).reshape((4, columns) + flat[0].shape)
+    return stacked if ctx.mueller else stacked[:, 0]
 
 
 class Volume(Effect):

@@ -105,7 +105,9 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
             ["R-hat max", "ESS min (bulk/tail)", "tau max (steps)", "acceptance", "walkers", "steps", "burn-in", "thin"],
             [[f"{diag['rhat_max']:.4f}", f"{diag['ess_min']:.0f}", f"{diag['tau_max']:.1f}", f"{diag['acceptance']:.2f}",
               s["sampler"]["walkers"], s["sampler"]["steps"], s["sampler"]["burn_in"], s["sampler"]["thin"]]])),
-        ("What the data determine", H.bullets(s["identifiability"]["findings"])),
+        ("What the data determine", H.bullets(s["identifiability"]["findings"])
+         + (H.paragraph("Where the chain started:") + H.bullets(s["start_search"]["findings"])
+            if s.get("start_search", {}).get("findings") else "")),
         ("Fit", H.table(["RMSE (DOP)", "reduced chi^2", "ELPD-LOO", "SE"],
                         [[_fmt(fit["rmse_dop"]), f"{fit['chi2_red']:.3f}", f"{fit['elpd_loo']:.2f}", f"{fit['elpd_loo_se']:.2f}"]])
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "

@@ -44,11 +44,11 @@ def default_walkers(ndim: int) -> int:
 
 
 def initial_ball(posterior, rng, walkers, init_evaluations=3000):
-    """Walkers around the global optimum (``infer.optimum``)."""
-    from ..optimum import find_optimum
+    """(walkers around the best mode that independent global searches found, the ModeSearch) (``infer.modes``)."""
+    from ..modes import search_modes
 
-    _, centre = find_optimum(posterior, rng, evaluations=init_evaluations)
-    return ball(posterior, centre, walkers, rng)
+    modes = search_modes(posterior, rng, evaluations=init_evaluations)
+    return ball(posterior, modes.best.theta, walkers, rng), modes
 
 
 def ball(posterior, centre, walkers, rng):
@@ -100,14 +100,34 @@ def _rhat_ess(sampler, tau, space):
     return worst_rhat_ess(chain.transpose(1, 0, 2))
 
 
-def starting_points(posterior, rng, count: int, initial=None) -> np.ndarray:
-    """(count, D) starting parameter vectors: ``initial`` as given, prior draws for "prior", or by default a
-    small ball around the global optimum."""
+def starting_points(posterior, rng, count: int, initial=None):
+    """((count, D) starting parameter vectors, the ModeSearch behind them or None): ``initial`` as given, prior
+    draws for "prior", or by default a small ball around the best mode of the start-point searches."""
     if initial is None:
         return initial_ball(posterior, rng, count)
     if isinstance(initial, str) and initial == "prior":
-        return posterior.priors.sample(rng, count)
-    return np.atleast_2d(np.asarray(initial, float))
+        return posterior.priors.sample(rng, count), None
+    return np.atleast_2d(np.asarray(initial, float)), None
+
+
+def _store_modes(path, modes) -> None:
+    """The start-point searches' modes travel with the chain, so a resumed run reports them too."""
+    import json
+
+    import h5py
+
+    with h5py.File(path, "a") as f:
+        f.attrs["spacepol_start_search"] = json.dumps(modes)
+
+
+def _stored_modes(path):
+    import json
+
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        text = f.attrs.get("spacepol_start_search")
+    return None if text is None else json.loads(str(text))
 
 
 def _moves():
@@ -170,11 +190,20 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     # compiled size, 64, tripled the cost of a full-Mueller step)
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
+    start_search = None
     if resumed:
         space = space or _stored_space(backend_path, posterior.priors)
+        start_search = _stored_modes(backend_path)
     else:
         random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-        initial = starting_points(posterior, rng, walkers, initial)
+        initial, modes = starting_points(posterior, rng, walkers, initial)
+        if modes is not None:
+            start_search = modes.to_json() | {"findings": modes.findings()}
+            if progress:
+                for line in modes.findings():
+                    print(f"  {line}", file=sys.stderr)
+            if backend_path is not None:
+                _store_modes(backend_path, start_search)
         if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
             space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
         if backend_path is not None:
@@ -247,6 +276,8 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         "acceptance": float(np.mean(sampler.acceptance_fraction)), "capped": capped,
         "resumed": resumed, "moves": "DE", "space": space.name,
     }
+    if start_search is not None:
+        info["start_search"] = start_search
     return Result(
         method="emcee", model=model_name, names=list(posterior.names),
         best=dict(zip(posterior.names, map(float, best))), objective=float(-log_prob[flat_i]),

@@ -56,7 +56,7 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
 
     start = time.perf_counter()
     space = space or SamplingSpace(posterior.priors)
-    z0 = jnp.asarray(space.to_z(starting_points(posterior, rng, chains, initial)))
+    z0 = jnp.asarray(space.to_z(starting_points(posterior, rng, chains, initial)[0]))
     kernel = NUTS(potential_fn=_potential(posterior, space), dense_mass=True, target_accept_prob=target_accept)
     mcmc = MCMC(kernel, num_warmup=warmup, num_samples=draws, num_chains=chains, chain_method="vectorized",
                 progress_bar=False)

@@ -50,21 +50,23 @@ def _assert_close(ours, theirs, what):
     np.testing.assert_allclose(ours / ours[0, 0], theirs / m11, rtol=0, atol=1e-6, err_msg=f"{what}: m_ij")
 
 
-CODE_WHITNEY = [  # (n, k, g, plmax, pcmax, s, log_absorption)
-    (1.35, 0.0, 0.4, 0.8, 0.3, 0.5, -1.0),
-    (1.5, 0.0, -0.3, 1.0, -0.6, 0.0, -3.0),
-    (2.2, 0.001, 0.7, 0.5, 0.2, -0.4, 0.5),
+CODE_WHITNEY = [  # (n, k, g, plmax, pcmax, s, log_absorption, depoll, depolc)
+    (1.35, 0.0, 0.4, 0.8, 0.3, 0.5, -1.0, 0.0, 0.0),
+    (1.5, 0.0, -0.3, 1.0, -0.6, 0.0, -3.0, 0.3, 0.7),
+    (2.2, 0.001, 0.7, 0.5, 0.2, -0.4, 0.5, 0.9, 0.1),
 ]
 
 
-@pytest.mark.parametrize("n,k,g,pl,pc,s,la", CODE_WHITNEY)
-def test_volume_code_whitney_matches_scatmech(n, k, g, pl, pc, s, la):
+@pytest.mark.parametrize("n,k,g,pl,pc,s,la,dl,dc", CODE_WHITNEY)
+def test_volume_code_whitney_matches_scatmech(n, k, g, pl, pc, s, la, dl, dc):
     peer = _scatmech(n, k, {"phase_function": "CodeWhitney_Phase_Function",
                             "phase_function.phase_function": "Henyey_Greenstein_Phase_Function",
                             "phase_function.phase_function.g": g, "phase_function.plmax": pl, "phase_function.pcmax": pc,
-                            "phase_function.s": s, "phase_function.log_absorption": la, "phase_function.log_scattering": 0})
+                            "phase_function.s": s, "phase_function.log_absorption": la, "phase_function.log_scattering": 0,
+                            "depoll": dl, "depolc": dc})
     ti, tr, ps = _corpus()
-    values = {"n": n, "k": k, "sigma": 0.2, "ks": 0.0, "w_vol": _albedo(la, k), "g_vol": g, "pl_vol": pl, "pc_vol": pc, "s_vol": s}
+    values = {"n": n, "k": k, "sigma": 0.2, "ks": 0.0, "w_vol": _albedo(la, k), "g_vol": g, "pl_vol": pl, "pc_vol": pc, "s_vol": s,
+              "dl_vol": dl, "dc_vol": dc}
     ours = Model.from_string("specular+volume").evaluate(values, Geometry(ti, tr, 180.0 - ps), mueller=True).mueller
     theirs = _theirs(peer, ti, tr, ps)
     _assert_close(ours, theirs, f"Code-Whitney n={n} k={k} g={g}")
@@ -109,7 +111,7 @@ def test_rayleigh_normalisation_agrees_with_a_small_sphere():
 
 
 @pytest.mark.parametrize("spec,values", [
-    ("specular+volume", {"w_vol": 0.8, "g_vol": 0.5, "pl_vol": 0.7, "pc_vol": 0.4, "s_vol": 0.3}),
+    ("specular+volume", {"w_vol": 0.8, "g_vol": 0.5, "pl_vol": 0.7, "pc_vol": 0.4, "s_vol": 0.3, "dl_vol": 0.4, "dc_vol": 0.6}),
     ("specular+smith+subsurface+volume", {"rho_s": 0.7, "w_vol": 0.8, "g_vol": -0.2, "pl_vol": 0.9, "pc_vol": -0.3}),
     ("specular+volume_rayleigh", {"w_ray": 0.6}),
 ])

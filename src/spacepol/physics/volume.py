@@ -153,14 +153,18 @@ def rayleigh_phase(cos_theta):
     return 3.0 * (1.0 + cos_theta * cos_theta) / (16.0 * np.pi)
 
 
-def single_scattering(ctx: Context, albedo, phase_matrix):
+def single_scattering(ctx: Context, albedo, phase_matrix, depolarization=(0.0, 0.0)):
     """The lobe of light scattered once under the interface: ``phase_matrix(cos Theta)`` -> 4 x 4 nested lists in the
     scattering plane's (parallel, perpendicular) basis; (4, 4, ...) with ``ctx.mueller``, else the Stokes vector
     for unpolarized light (the matrix's first column).
 
     The way in (transmission, then the change of basis into the scattering plane) and the way out are each one
     Jones matrix, J_in = R_in diag(t_s, t_p) and J_out = diag(t_s, t_p) R_out, so M = A_out P A_in with A the
-    Mueller matrices of the two; the power factors n mu' / cos(theta) of the transmissions go into the scale."""
+    Mueller matrices of the two; the power factors n mu' / cos(theta) of the transmissions go into the scale.
+
+    ``depolarization`` = (linear, circular): SCATMECH's depoll, depolc, the share of the light's linear and
+    circular polarization lost on its path in and out (further scattering along the way), split between the two
+    paths by their lengths: diag(1, 1 - d mu_r'/(mu_i' + mu_r'), ...) on the way in, mu_i' on the way out."""
     geo = ctx.geometry
     n, k = ctx["n"], ctx["k"]
     k_i, k_r = _components(geo.k_i), _components(geo.k_r)
@@ -187,6 +191,12 @@ def single_scattering(ctx: Context, albedo, phase_matrix):
     columns = 4 if ctx.mueller else 1
     inner = _times(phase_matrix(_dot(d_in, d_out)), [row[:columns] for row in a_in], columns)
     total = _times(jones_mueller(j_out), inner, columns)
+    linear, circular = depolarization
+    if not (_is_zero(linear) and _is_zero(circular)):
+        share_in, share_out = mu_out / (mu_in + mu_out), mu_in / (mu_in + mu_out)
+        keep_in = (1.0, 1.0 - linear * share_in, 1.0 - linear * share_in, 1.0 - circular * share_in)
+        keep_out = (1.0, 1.0 - linear * share_out, 1.0 - linear * share_out, 1.0 - circular * share_out)
+        total = [[v if _is_zero(v) else v * keep_out[i] * keep_in[j] for j, v in enumerate(row)] for i, row in enumerate(total)]
     flat = jnp.broadcast_arrays(*[jnp.asarray(v, dtype=float) * scale for row in total for v in row])
     stacked = jnp.stack(flat).reshape((4, columns) + flat[0].shape)
     return stacked if ctx.mueller else stacked[:, 0]
@@ -205,6 +215,10 @@ class Volume(Effect):
                   "made from linear by one scattering", physical=(-1.0, 1.0)),
         Parameter("s_vol", "", Uniform(-1.0, 1.0), 0.0, "skew of the P34 term towards small angles (Code-Whitney s)",
                   fixed=True),
+        Parameter("dl_vol", "", Uniform(0.0, 1.0), 0.0, "share of the linear polarization lost on the paths in and out "
+                  "(SCATMECH's depoll)", physical=(0.0, 1.0)),
+        Parameter("dc_vol", "", Uniform(0.0, 1.0), 0.0, "share of the circular polarization lost on the paths in and out "
+                  "(SCATMECH's depolc)", physical=(0.0, 1.0)),
     )
     requires = ("specular",)
     description = (
@@ -214,7 +228,9 @@ class Volume(Effect):
         "polarization (P12, largest at 90 deg: pl_vol) and retardance (P34: pc_vol), and refracts out; "
         "f = w_vol T(theta_r) P(Theta) T(theta_i) / (n^2 (mu_i' + mu_r')). Unlike multiply scattered light it "
         "stays polarized out of the plane of incidence and fills the linear Mueller block with structure that "
-        "follows the internal scattering angle. Reciprocal. Add `subsurface` for the light scattered many times."
+        "follows the internal scattering angle; dl_vol and dc_vol (SCATMECH's depoll, depolc) let part of its linear "
+        "and circular polarization be lost on the way in and out, in proportion to each path's length. Reciprocal. "
+        "Add `subsurface` for the light scattered many times."
     )
     slot = "volume"
     removable = True
@@ -226,7 +242,7 @@ class Volume(Effect):
             phase = henyey_greenstein(ctx["g_vol"], cos_theta)
             return code_whitney(phase, cos_theta, ctx["pl_vol"], ctx["pc_vol"], ctx["s_vol"])
 
-        return single_scattering(ctx, ctx["w_vol"], phase_matrix)
+        return single_scattering(ctx, ctx["w_vol"], phase_matrix, (ctx["dl_vol"], ctx["dc_vol"]))
 
 
 class VolumeRayleigh(Effect):

@@ -92,19 +92,19 @@ def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
     return np.array(pairs, int).reshape(-1, 2)
 
 
-def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, list]:
-    """{noise parameter: [arrays of differences]} for every inferred channel of the likelihood."""
-    out: dict[str, list] = {}
+def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict]:
+    """{noise parameter: {source: [arrays of differences]}} for every inferred channel of the likelihood."""
+    out: dict[str, dict] = {}
     observed = likelihood.observed()
     for channel, y in observed.items():
         parameter = likelihood.noise_parameter(channel)
         if parameter is None:  # the file gives errors: nothing to infer
             continue
         owner = likelihood.observable_of(channel)
-        diffs = out.setdefault(parameter, [])
+        sources = out.setdefault(parameter, {})
         if len(pairs_repeated):
             a, b = pairs_repeated.T
-            diffs.append(np.asarray(owner.residual(channel, y[b], y[a], True), float))
+            sources.setdefault("repeated geometries", []).append(np.asarray(owner.residual(channel, y[b], y[a], True), float))
         if not len(pairs_reciprocal):
             continue
         if owner.name == "mueller":
@@ -112,10 +112,11 @@ def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, list
             mirror = observed[f"m{j + 1}{i + 1}"] if i != j else y
             a, b = pairs_reciprocal.T
             keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
-            diffs.append(y[b[keep]] - _Q[i] * _Q[j] * mirror[a[keep]])
+            sources.setdefault("reciprocal pairs", []).append(y[b[keep]] - _Q[i] * _Q[j] * mirror[a[keep]])
         elif owner.name == "brdf":
             a, b = pairs_reciprocal[pairs_reciprocal[:, 0] != pairs_reciprocal[:, 1]].T
-            diffs.append(np.asarray(owner.residual(channel, y[b], y[a], likelihood.inferred(channel)), float))
+            sources.setdefault("reciprocal pairs", []).append(
+                np.asarray(owner.residual(channel, y[b], y[a], likelihood.inferred(channel)), float))
     return out
 
 
@@ -126,11 +127,12 @@ def measure(likelihood) -> dict[str, MeasuredNoise]:
     reciprocal, repeated = reciprocal_pairs(data), repeated_pairs(data)
     if not len(reciprocal) and not len(repeated):
         return {}
-    source = " and ".join(s for s, p in (("reciprocal pairs", reciprocal), ("repeated geometries", repeated)) if len(p))
     out = {}
-    for parameter, parts in _differences(likelihood, reciprocal, repeated).items():
-        d = np.concatenate([np.ravel(p) for p in parts]) if parts else np.empty(0)
-        d = d[np.isfinite(d)]
+    for parameter, sources in _differences(likelihood, reciprocal, repeated).items():
+        parts = {name: np.concatenate([np.ravel(p) for p in arrays]) for name, arrays in sources.items()}
+        parts = {name: d[np.isfinite(d)] for name, d in parts.items()}
+        source = " and ".join(name for name, d in parts.items() if d.size)
+        d = np.concatenate(list(parts.values())) if parts else np.empty(0)
         if d.size < MIN_DIFFERENCES:
             continue
         value = _MAD_TO_SIGMA * float(np.median(np.abs(d))) / np.sqrt(2.0)

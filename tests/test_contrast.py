@@ -116,13 +116,20 @@ def _two_wavelength_run_dir(tmp_path):
     return run
 
 
-def _target_dop(tmp_path, run, wavelength, *extra):
+def _scenario(tmp_path, wavelength):
     scenario = tmp_path / f"s{wavelength}.toml"
     scenario.write_text(f'[target]\nwavelength_um = {wavelength}\n[[cases]]\nname = "fixed"\nzenith_deg = 40\n'
                         'azimuth_deg = 100\nsky_dop = 0.4\ntheta_r_deg = 55\n')
-    out = tmp_path / f"c{wavelength}{''.join(extra)}"
-    r = _cli("contrast", run, "--scenario", scenario, "--draws", 200, "--out", out, *extra)
-    return r, (json.loads((out / "contrast.json").read_text()) if r.returncode == 0 else None)
+    return scenario
+
+
+def _target_dop(tmp_path, run, wavelength, extrapolate=False):
+    """contrast.json of the run at the scenario's wavelength, through the library (the command line is the
+    same call: test_contrast_of_a_point_posterior_is_exact)."""
+    from spacepol.report.contrast_report import make_contrast_report
+
+    return make_contrast_report(run, read_scenario(_scenario(tmp_path, wavelength)), tmp_path / f"c{wavelength}{extrapolate}",
+                                draws=200, extrapolate=extrapolate)
 
 
 def _paper_dop(n, k):
@@ -137,18 +144,15 @@ def test_contrast_of_a_two_wavelength_run_uses_that_runs_n_and_k(tmp_path):
     run = _two_wavelength_run_dir(tmp_path)
     at_532, at_1064, default = _paper_dop(2.2, 0.0), _paper_dop(1.3, 0.1), _paper_dop(1.5, 0.0)
     assert min(abs(at_532 - at_1064), abs(at_532 - default), abs(at_1064 - default)) > 0.02
-    r, report = _target_dop(tmp_path, run, 0.532)
-    assert r.returncode == 0, r.stderr
+    report = _target_dop(tmp_path, run, 0.532)
     assert report["rows"][0]["target_dop"]["median"] == pytest.approx(at_532, rel=1e-3)
     assert report["material"]["wavelength_um"] == 0.532 and "as measured at 0.532" in report["material"]["rule"]
-    r, report = _target_dop(tmp_path, run, 0.798)  # halfway: n 1.75, k 0.05
-    assert r.returncode == 0, r.stderr
+    report = _target_dop(tmp_path, run, 0.798)  # halfway: n 1.75, k 0.05
     assert report["rows"][0]["target_dop"]["median"] == pytest.approx(_paper_dop(1.75, 0.05), rel=1e-3)
     assert "interpolated" in report["material"]["rule"]
-    r, report = _target_dop(tmp_path, run, 1.65)
+    r = _cli("contrast", run, "--scenario", _scenario(tmp_path, 1.65), "--draws", 200, "--out", tmp_path / "c1.65")
     assert r.returncode == 2 and "outside the run's measured 0.532-1.064 um" in r.stderr and "--extrapolate" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "c1.65").exists()
-    r, report = _target_dop(tmp_path, run, 1.65, "--extrapolate")
-    assert r.returncode == 0, r.stderr
+    report = _target_dop(tmp_path, run, 1.65, extrapolate=True)
     assert report["rows"][0]["target_dop"]["median"] == pytest.approx(at_1064, rel=1e-3)
     assert report["material"]["extrapolated"] is True and "nearest measured wavelength 1.064" in report["material"]["rule"]

@@ -7,12 +7,14 @@ from hypothesis import given, settings, strategies as st
 from spacepol.physics import Geometry, Model
 from spacepol.physics.effects import registry
 
-# Two models that between them hold every built-in effect once.
+# Models that between them hold every built-in effect.
 MODELS = [
     "specular+shadowing+body+polarized_diffuse+depolarization+oxide_layer+angle_offset+extinction+dop_bias",
     "specular+smith+ggx+anisotropy+body+polarized_diffuse+lambertian+subsurface",
     "specular+shadowing+body+polarized_diffuse+depolarization+extinction+dop_bias",
     "specular+smith+ggx+body",
+    "specular+smith+subsurface+volume",
+    "specular+shadowing+lambertian+volume_rayleigh",
 ]
 
 

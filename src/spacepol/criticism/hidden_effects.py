@@ -44,6 +44,8 @@ HIDDEN_VALUES = {  # per built-in effect: a small and a large value, inside the 
     "oxide_layer": [{"thickness_um": 0.05, "n_film": 1.46}, {"thickness_um": 0.25, "n_film": 1.7}],
     "lambertian": [{"rho_l": 0.05}, {"rho_l": 0.3}],
     "subsurface": [{"rho_s": 0.2}, {"rho_s": 0.7}],
+    "volume": [{"w_vol": 0.5, "g_vol": 0.3, "pl_vol": 0.8, "pc_vol": 0.0}, {"w_vol": 1.0, "g_vol": -0.2, "pl_vol": 1.0, "pc_vol": 0.3}],
+    "volume_rayleigh": [{"w_ray": 0.5}, {"w_ray": 1.0}],
 }
 NOISE = [(0.002, 0.01), (0.01, 0.05)]  # (DOP absolute, BRDF relative): a good lab polarimeter, a field one
 WAVELENGTH_UM = 0.633

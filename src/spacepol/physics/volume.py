@@ -47,9 +47,12 @@ def _internal_direction(k_out, n, into: bool):
     the surface) is ``k_out``: Snell's law, the horizontal part divided by n. Returns (vector, mu') with mu'
     the internal cosine; where no light gets through (n < sin(theta): total reflection) mu' is ~0."""
     kx, ky, _ = k_out
-    mu = jnp.sqrt(jnp.maximum(1.0 - (kx * kx + ky * ky) / (n * n), _TINY))
-    sign = -1.0 if into else 1.0
-    return (sign * kx / n, sign * ky / n, sign * mu), mu
+    h2 = (kx * kx + ky * ky) / (n * n)  # sin^2 of the internal angle; > 1 where no light gets through
+    # there the direction is kept a unit vector at grazing (the transmission, ~mu', is ~0 anyway)
+    shrink = jnp.where(h2 > 1.0 - _TINY, jnp.sqrt((1.0 - _TINY) / jnp.maximum(h2, _TINY)), 1.0)
+    mu = jnp.sqrt(jnp.maximum(1.0 - h2 * shrink * shrink, _TINY))
+    sign = (-1.0 if into else 1.0) * shrink / n
+    return (sign * kx, sign * ky, (-1.0 if into else 1.0) * mu), mu
 
 
 # Stokes S_k = E^dagger sigma_k E in each beam's (s, p) basis (S1 > 0 for s; S3 = 2 Im(E_s* E_p), the sign of

@@ -51,19 +51,26 @@ def mueller_set(kind: str, noise_m: float = 0.005, noise_brdf: float = 0.02, see
         elif kind == "subsurface":
             M = M + np.array(under.MuellerBRDF(*args))
         mueller[:, :, j] = M
-    rng = np.random.default_rng(seed)
-    normalised = mueller / mueller[0, 0]
-    noisy = normalised + noise_m * rng.standard_normal(normalised.shape)
+    data = measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed), f"SCATMECH render ({kind})")
+    # the same measurement reduced to DOP (from the first column) and BRDF
+    noisy = data.mueller / data.mueller[0, 0]
+    data.dop = np.clip(np.sqrt(np.sum(noisy[1:, 0] ** 2, axis=0)), 0, 1)
+    data.dop_err = np.full(g.size, noise_m)
+    return data
+
+
+def measured(g: Geometry, mueller, noise_m: float, noise_brdf: float, rng: np.random.Generator, source: str) -> Dataset:
+    """A measurement of the Mueller matrices ``mueller`` (4, 4, N) at ``g``: the 15 normalised elements with
+    absolute noise ``noise_m`` (clipped to [-1, 1]), the BRDF with relative noise ``noise_brdf``, both errors in
+    the file."""
+    noisy = mueller / mueller[0, 0] + noise_m * rng.standard_normal(mueller.shape)
     noisy[0, 0] = 1.0
     brdf = mueller[0, 0] * (1 + noise_brdf * rng.standard_normal(g.size))
     data = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=np.full(g.size, 0.633))
     data.mueller = np.clip(noisy, -1, 1) * brdf
     data.mueller_err = np.full((4, 4, g.size), noise_m)
     data.brdf, data.brdf_err = brdf, noise_brdf * mueller[0, 0]
-    # the same measurement reduced to DOP (from the first column) and BRDF
-    data.dop = np.clip(np.sqrt(np.sum(noisy[1:, 0] ** 2, axis=0)), 0, 1)
-    data.dop_err = np.full(g.size, noise_m)
-    data.source = f"SCATMECH render ({kind})"
+    data.source = source
     return data
 
 
@@ -113,14 +120,5 @@ def ptfe_like_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float
         if volume:
             M = M + np.array(once.MuellerBRDF(*args))
         mueller[:, :, j] = M
-    rng = np.random.default_rng(seed)
-    normalised = mueller / mueller[0, 0]
-    noisy = normalised + noise_m * rng.standard_normal(normalised.shape)
-    noisy[0, 0] = 1.0
-    brdf = mueller[0, 0] * (1 + noise_brdf * rng.standard_normal(g.size))
-    data = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=np.full(g.size, 0.633))
-    data.mueller = np.clip(noisy, -1, 1) * brdf
-    data.mueller_err = np.full((4, 4, g.size), noise_m)
-    data.brdf, data.brdf_err = brdf, noise_brdf * mueller[0, 0]
-    data.source = f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)"
-    return data
+    return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed),
+                    f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)")

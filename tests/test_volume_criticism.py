@@ -11,7 +11,7 @@ standing in for it), with reduced chi^2 < 1.5 and n close to the truth; the cont
 import numpy as np
 import pytest
 
-from scatmech_sets import PTFE_LIKE, ptfe_like_geometry, ptfe_like_set
+from scatmech_sets import PTFE_LIKE, measured, ptfe_like_geometry, ptfe_like_set
 from spacepol.criticism.rounds import diagnose_rounds
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
@@ -41,15 +41,7 @@ def own_render(noise_m=0.012, noise_brdf=0.02, seed=4) -> tuple[Dataset, dict]:
     truth = {**PTFE_LIKE, "n": 1.40, "sigma": 0.25, "ks": 0.2, "rho_s": 0.85}
     g = ptfe_like_geometry()
     m = Model.from_string("specular+smith+subsurface+volume").evaluate(truth, g, mueller=True).mueller
-    rng = np.random.default_rng(seed)
-    normalised = m / m[0, 0] + noise_m * rng.standard_normal(m.shape)
-    normalised[0, 0] = 1.0
-    brdf = m[0, 0] * (1 + noise_brdf * rng.standard_normal(g.size))
-    data = Dataset(g.theta_i, g.theta_r, g.dphi, wavelength_um=np.full(g.size, 0.633))
-    data.mueller, data.mueller_err = np.clip(normalised, -1, 1) * brdf, np.full(m.shape, noise_m)
-    data.brdf, data.brdf_err = brdf, noise_brdf * m[0, 0]
-    data.source = "spacepol render specular+smith+subsurface+volume"
-    return data, truth
+    return measured(g, m, noise_m, noise_brdf, np.random.default_rng(seed), "spacepol render specular+smith+subsurface+volume"), truth
 
 
 # the changes that matter here (the whole library is slow at this size: see benchmarks/diagnose_speed.py)

@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..infer.measured_noise import reciprocal_pairs
+from ..infer.measured_noise import RECIPROCITY_SIGNS, reciprocal_pairs
 from ..physics.geometry import Geometry
 
-Q = np.diag([1.0, 1.0, -1.0, 1.0])
+Q = np.diag(RECIPROCITY_SIGNS)
 
 
 def reciprocal_image(mueller) -> np.ndarray:

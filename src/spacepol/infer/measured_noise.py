@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..observables.mueller import ELEMENTS, index
+from ..observables.mueller import index
 
-_Q = np.array([1.0, 1.0, -1.0, 1.0])
+RECIPROCITY_SIGNS = np.array([1.0, 1.0, -1.0, 1.0])  # the diagonal of Q in M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q
 _MAD_TO_SIGMA = 1.482602218505602
 _MAD_RELATIVE_SE = 1.166  # sqrt(1 / (2 x 0.3675)): relative standard error of a MAD-based sigma, times sqrt(K)
 MIN_DIFFERENCES = 20  # fewer differences measure nothing worth a floor
@@ -51,40 +51,39 @@ class MeasuredNoise:
                 "n_differences": self.n_differences, "source": self.source}
 
 
-def _rounded(ti, tr, dphi, wl, tol):
+def _keys(theta_i, theta_r, dphi, wl, tol) -> list[tuple]:
+    """One hashable key per row: the geometry rounded to ``tol`` degrees and the wavelength to 1e-4 um."""
     # NIST's file stores normal incidence as 0.001 deg and normal reflection as 0: both are 0 here
-    ti, tr = (0.0 if abs(ti) < 0.01 else ti), (0.0 if abs(tr) < 0.01 else tr)
+    theta_i = np.where(np.abs(theta_i) < 0.01, 0.0, theta_i)
+    theta_r = np.where(np.abs(theta_r) < 0.01, 0.0, theta_r)
     dphi = (dphi + 180.0) % 360.0 - 180.0
-    return (round(ti / tol), round(tr / tol), round((180.0 if abs(dphi + 180.0) < tol else dphi) / tol), round(wl * 1e4))
+    dphi = np.where(np.abs(dphi + 180.0) < tol, 180.0, dphi)
+    rounded = np.column_stack([np.round(theta_i / tol), np.round(theta_r / tol), np.round(dphi / tol), np.round(wl * 1e4)])
+    return list(map(tuple, rounded.astype(np.int64).tolist()))
 
 
-def _keys(data, tolerance_deg):
-    wl = np.zeros(len(data)) if data.wavelength_um is None else data.wavelength_um
-    return wl, {j: _rounded(data.theta_i[j], data.theta_r[j], data.dphi[j], wl[j], tolerance_deg) for j in range(len(data))}
+def _wavelengths(data) -> np.ndarray:
+    return np.zeros(len(data)) if data.wavelength_um is None else np.asarray(data.wavelength_um, float)
 
 
 def reciprocal_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
     """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
     (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
     and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
-    wl, keys = _keys(data, tolerance_deg)
+    wl = _wavelengths(data)
     rows: dict = {}
-    for j, key in keys.items():
+    for j, key in enumerate(_keys(data.theta_i, data.theta_r, data.dphi, wl, tolerance_deg)):
         rows.setdefault(key, []).append(j)
-    pairs = []
-    for j in range(len(data)):
-        for k in rows.get(_rounded(data.theta_r[j], data.theta_i[j], -data.dphi[j], wl[j], tolerance_deg), []):
-            if j <= k:
-                pairs.append((j, k))
+    swapped = _keys(data.theta_r, data.theta_i, -np.asarray(data.dphi, float), wl, tolerance_deg)
+    pairs = [(j, k) for j, key in enumerate(swapped) for k in rows.get(key, []) if j <= k]
     return np.array(pairs, int).reshape(-1, 2)
 
 
 def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
     """(K, 2) row indices (a, b), a < b, of geometries measured more than once (each later row with the first)."""
-    _, keys = _keys(data, tolerance_deg)
     first: dict = {}
     pairs = []
-    for j, key in keys.items():
+    for j, key in enumerate(_keys(data.theta_i, data.theta_r, data.dphi, _wavelengths(data), tolerance_deg)):
         if key in first:
             pairs.append((first[key], j))
         else:
@@ -112,7 +111,7 @@ def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict
             mirror = observed[f"m{j + 1}{i + 1}"] if i != j else y
             a, b = pairs_reciprocal.T
             keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
-            sources.setdefault("reciprocal pairs", []).append(y[b[keep]] - _Q[i] * _Q[j] * mirror[a[keep]])
+            sources.setdefault("reciprocal pairs", []).append(y[b[keep]] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * mirror[a[keep]])
         elif owner.name == "brdf":
             a, b = pairs_reciprocal[pairs_reciprocal[:, 0] != pairs_reciprocal[:, 1]].T
             sources.setdefault("reciprocal pairs", []).append(
@@ -141,4 +140,4 @@ def measure(likelihood) -> dict[str, MeasuredNoise]:
     return out
 
 
-__all__ = ["ELEMENTS", "MeasuredNoise", "measure", "reciprocal_pairs", "repeated_pairs"]
+__all__ = ["MeasuredNoise", "RECIPROCITY_SIGNS", "measure", "reciprocal_pairs", "repeated_pairs"]

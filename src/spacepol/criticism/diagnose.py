@@ -23,10 +23,9 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
-from ..infer.inversion import explains
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
-from ..infer.inversion import invert
+from ..infer.inversion import explains, invert
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model

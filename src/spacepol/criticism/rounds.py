@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 
-from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels
+from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels, misfit_words
 from ..physics.model import Model
 from .changes import changes, slot_alternatives
 from .diagnose import _structured, diagnose, significant
@@ -125,9 +125,7 @@ def _conclusion(path: list[dict], reports: list[dict]) -> str:
         text = f"No change of {path[0]['model']} improves ELPD-LOO by more than 2 SE (and 4)."
     else:
         text = f"Path: {route}; {stopped}."
-    fit = fit_words(final["fit"]["chi2_red"], final["inferred_noise"])
-    if final.get("noise"):
-        fit += "; misfit (inferred / measured noise) " + ", ".join(f"{k} {v['ratio']:.2f}" for k, v in final["noise"].items())
+    fit = fit_words(final["fit"]["chi2_red"], final["inferred_noise"]) + misfit_words(final.get("noise"))
     if final["structured"]:
         text += (f" Partly explained: the final model {final['model']} still leaves structured residuals ({fit}; "
                  + " ".join(final["residual_structure"]) + "). The structure that remains points to an effect the library "

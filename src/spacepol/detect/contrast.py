@@ -41,13 +41,14 @@ def scenario_wavelength_um(scenario) -> float:
     return float(given) if given else 0.5 * (inst["band_low_um"] + inst["band_high_um"])
 
 
-def material_samples(model, samples: dict, scenario, summary: dict, extrapolate: bool = False):
+def material_samples(model, samples: dict, scenario, spec, extrapolate: bool = False):
     """(one-wavelength model, {parameter: posterior draws} at the scenario's wavelength, contrast.json's
     ``material`` record: the wavelength, the run's wavelengths and the rule that gave n and k there).
 
     A run over several wavelengths gives n, k at the scenario's wavelength from its dispersion law or by linear
     interpolation between the measured wavelengths around it (``SpectralModel.values_at_wavelength``); outside
-    the measured range only with ``extrapolate``. A one-wavelength run's draws are used as measured."""
+    the measured range only with ``extrapolate``. A one-wavelength run's draws are used as measured (``spec``: the
+    run's stored model spec, which names its wavelength; a bare model name does not)."""
     from ..errors import SpacepolError
     from ..physics.spectral import SpectralModel
 
@@ -60,7 +61,7 @@ def material_samples(model, samples: dict, scenario, summary: dict, extrapolate:
                                 "--extrapolate)") from None
         return model.model, params, {"wavelength_um": lam, "measured_wavelengths_um": list(model.wavelengths),
                                      "rule": rule, "extrapolated": not (model.wavelengths[0] <= lam <= model.wavelengths[-1])}
-    measured = (summary.get("spec") or {}).get("wavelengths_um") if isinstance(summary.get("spec"), dict) else None
+    measured = spec.get("wavelengths_um") if isinstance(spec, dict) else None
     at = f" at {measured[0]:g} um" if measured else ""
     return model, samples, {"wavelength_um": lam, "measured_wavelengths_um": measured,
                             "rule": f"the run's one-wavelength posterior{at} used as measured (no dispersion to "

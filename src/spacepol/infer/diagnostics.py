@@ -103,7 +103,11 @@ def fit_words(chi2_red: float, noise: dict[str, float]) -> str:
 def describe_fit(summary: dict) -> str:
     """``fit_words`` of a run's summary, and where the data measure their own noise, the misfit per group
     (inferred / measured noise)."""
-    words = fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary))
-    if summary.get("noise"):
-        words += "; misfit (inferred / measured noise) " + ", ".join(f"{k} {v['ratio']:.2f}" for k, v in summary["noise"].items())
-    return words
+    return fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary)) + misfit_words(summary.get("noise"))
+
+
+def misfit_words(noise: dict | None) -> str:
+    """"; misfit (inferred / measured noise) GROUP RATIO, ..." for summary.json's ``noise``, "" without it."""
+    if not noise:
+        return ""
+    return "; misfit (inferred / measured noise) " + ", ".join(f"{k} {v['ratio']:.2f}" for k, v in noise.items())

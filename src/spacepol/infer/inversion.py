@@ -98,7 +98,8 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     loo_result = loo(idata)
     summary = {
         "model": posterior.likelihood.model.name,
-        "spec": spec_of(posterior.likelihood.model),  # the whole model: what contrast and Result.load rebuild
+        # the whole model: what contrast rebuilds
+        "spec": spec_of(posterior.likelihood.model, posterior.likelihood.data.wavelength_um),
         "parameters": quantiles(result),
         "diagnostics": convergence(idata, result),
         "fit": fit_statistics(posterior, result, loo_result),
@@ -118,9 +119,6 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     noise = noise_ratios(posterior, summary["parameters"])
     if noise:
         summary["noise"] = noise
-    data_wavelengths = posterior.likelihood.data.wavelength_um
-    if summary["spec"]["wavelengths_um"] is None and data_wavelengths is not None:
-        summary["spec"]["wavelengths_um"] = [float(w) for w in np.unique(data_wavelengths)]
     derived = getattr(posterior.likelihood.model, "derived", None)
     if derived is not None:  # values a dispersion law implies per wavelength (n@0.633 from A and B)
         values = derived(posterior.priors.to_params(result.flat_samples()))
@@ -142,7 +140,7 @@ def noise_ratios(posterior: Posterior, parameters: dict) -> dict:
     """summary.json's ``noise``: {noise parameter: {"inferred" (posterior median), "measured", "ratio", ...}} for
     the levels the data measure themselves. The ratio is the misfit the model hides in its inferred noise."""
     out = {}
-    for name, measured in getattr(posterior, "measured_noise", {}).items():
+    for name, measured in posterior.measured_noise.items():
         if name in parameters:
             inferred = float(parameters[name]["median"])
             out[name] = {"inferred": inferred, "measured": measured.value, "ratio": inferred / measured.value,

@@ -11,14 +11,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import SpacepolError
 from .model import Model
 from .registry import registry
 from .spectral import SpectralModel
 
 
-def spec_of(model) -> dict:
-    """{"effects", "plugins", "wavelengths_um", "dispersion"} of a Model or SpectralModel."""
+def spec_of(model, data_wavelengths_um=None) -> dict:
+    """{"effects", "plugins", "wavelengths_um", "dispersion"} of a Model or SpectralModel; a one-wavelength Model
+    records the wavelengths of the data it was fitted to (``data_wavelengths_um``, None when the data have none)."""
     inner = model.model if isinstance(model, SpectralModel) else model
     effects = [e.name for e in inner.effects]
     spec = {"effects": effects, "plugins": {name: registry.sources[name] for name in effects if name in registry.sources},
@@ -26,6 +29,8 @@ def spec_of(model) -> dict:
     if isinstance(model, SpectralModel):
         spec["wavelengths_um"] = list(model.wavelengths)
         spec["dispersion"] = dict(model.dispersion)
+    elif data_wavelengths_um is not None:
+        spec["wavelengths_um"] = [float(w) for w in np.unique(data_wavelengths_um)]
     return spec
 
 

@@ -51,8 +51,9 @@ def _internal_direction(k_out, n, into: bool):
     # there the direction is kept a unit vector at grazing (the transmission, ~mu', is ~0 anyway)
     shrink = jnp.where(h2 > 1.0 - _TINY, jnp.sqrt((1.0 - _TINY) / jnp.maximum(h2, _TINY)), 1.0)
     mu = jnp.sqrt(jnp.maximum(1.0 - h2 * shrink * shrink, _TINY))
-    sign = (-1.0 if into else 1.0) * shrink / n
-    return (sign * kx, sign * ky, (-1.0 if into else 1.0) * mu), mu
+    direction = -1.0 if into else 1.0  # down into the material, or up towards the surface
+    horizontal = direction * shrink / n
+    return (horizontal * kx, horizontal * ky, direction * mu), mu
 
 
 # Stokes S_k = E^dagger sigma_k E in each beam's (s, p) basis (S1 > 0 for s; S3 = 2 Im(E_s* E_p), the sign of
@@ -205,7 +206,27 @@ def single_scattering(ctx: Context, albedo, phase_matrix, depolarization=(0.0, 0
     return stacked if ctx.mueller else stacked[:, 0]
 
 
-class Volume(Effect):
+class SingleScattering(Effect):
+    """What `volume` and `volume_rayleigh` share: the slot ``volume`` (they replace each other), the lobe
+    ``single_scattering`` with the albedo ``intensity``; a member says its ``phase_matrix`` and, optionally, the
+    polarization lost on the paths in and out (``depolarization``)."""
+
+    requires = ("specular",)
+    slot = "volume"
+    removable = True
+
+    def phase_matrix(self, ctx, cos_theta):
+        raise NotImplementedError
+
+    def depolarization(self, ctx):
+        return (0.0, 0.0)
+
+    def lobe(self, ctx):
+        return single_scattering(ctx, ctx[self.intensity], lambda cos_theta: self.phase_matrix(ctx, cos_theta),
+                                 self.depolarization(ctx))
+
+
+class Volume(SingleScattering):
     name = "volume"
     parameters = (
         Parameter("w_vol", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the volume scatterers (scattering over "
@@ -223,7 +244,6 @@ class Volume(Effect):
         Parameter("dc_vol", "", Uniform(0.0, 1.0), 0.0, "share of the circular polarization lost on the paths in and out "
                   "(SCATMECH's depolc)", physical=(0.0, 1.0)),
     )
-    requires = ("specular",)
     description = (
         "Light scattered once inside the material (NIST SCATMECH's First_Diffuse_BRDF_Model with the "
         "Code-Whitney phase matrix): it refracts in through the interface (Fresnel transmission of the facets' "
@@ -235,38 +255,30 @@ class Volume(Effect):
         "and circular polarization be lost on the way in and out, in proportion to each path's length. Reciprocal. "
         "Add `subsurface` for the light scattered many times."
     )
-    slot = "volume"
-    removable = True
     intensity = "w_vol"
     neutral = {"w_vol": 0.0}
 
-    def lobe(self, ctx):
-        def phase_matrix(cos_theta):
-            phase = henyey_greenstein(ctx["g_vol"], cos_theta)
-            return code_whitney(phase, cos_theta, ctx["pl_vol"], ctx["pc_vol"], ctx["s_vol"])
+    def phase_matrix(self, ctx, cos_theta):
+        phase = henyey_greenstein(ctx["g_vol"], cos_theta)
+        return code_whitney(phase, cos_theta, ctx["pl_vol"], ctx["pc_vol"], ctx["s_vol"])
 
-        return single_scattering(ctx, ctx["w_vol"], phase_matrix, (ctx["dl_vol"], ctx["dc_vol"]))
+    def depolarization(self, ctx):
+        return (ctx["dl_vol"], ctx["dc_vol"])
 
 
-class VolumeRayleigh(Effect):
+class VolumeRayleigh(SingleScattering):
     name = "volume_rayleigh"
     parameters = (
         Parameter("w_ray", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the small (Rayleigh) scatterers",
                   physical=(0.0, 1.0)),
     )
-    requires = ("specular",)
     description = (
         "Light scattered once inside the material by scatterers much smaller than the wavelength: `volume` with "
         "the Rayleigh phase matrix (phase function 3 (1 + cos^2 Theta) / (16 pi), fully polarized at 90 deg, no "
         "retardance); f = w_ray T(theta_r) P(Theta) T(theta_i) / (n^2 (mu_i' + mu_r')). Reciprocal."
     )
-    slot = "volume"
-    removable = True
     intensity = "w_ray"
     neutral = {"w_ray": 0.0}
 
-    def lobe(self, ctx):
-        def phase_matrix(cos_theta):
-            return code_whitney(rayleigh_phase(cos_theta), cos_theta, 1.0, 0.0)
-
-        return single_scattering(ctx, ctx["w_ray"], phase_matrix)
+    def phase_matrix(self, ctx, cos_theta):
+        return code_whitney(rayleigh_phase(cos_theta), cos_theta, 1.0, 0.0)

@@ -51,7 +51,7 @@ def make_contrast_report(run_dir, scenario, out: Path, reading: str = "corrected
         raise SpacepolError(f"{run_dir}: the run has per-wavelength parameters but its summary.json stores only the model's "
                             "name; run it again with this version to store the whole model")
     model = model_from_spec(spec, str(run_dir))
-    inner, params, material = material_samples(model, samples, scenario, summary, extrapolate)
+    inner, params, material = material_samples(model, samples, scenario, spec, extrapolate)
     report = propagate(inner, params, scenario, np.random.default_rng(seed), draws=draws, reading=reading)
     report["material"] = material
     report["paper_table3"] = recompute(scenario.instrument)

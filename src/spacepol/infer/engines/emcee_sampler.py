@@ -26,6 +26,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 
@@ -110,44 +111,25 @@ def starting_points(posterior, rng, count: int, initial=None):
     return np.atleast_2d(np.asarray(initial, float)), None
 
 
-def _store_modes(path, modes) -> None:
-    """The start-point searches' modes travel with the chain, so a resumed run reports them too."""
-    import json
-
-    import h5py
-
-    with h5py.File(path, "a") as f:
-        f.attrs["spacepol_start_search"] = json.dumps(modes)
-
-
-def _stored_modes(path):
-    import json
-
-    import h5py
-
-    with h5py.File(path, "r") as f:
-        text = f.attrs.get("spacepol_start_search")
-    return None if text is None else json.loads(str(text))
-
-
 def _moves():
     return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
 
 
-def _store_space(path, space) -> None:
-    """The chain file holds the sampler's coordinates; it records which, so a resumed run uses the same."""
+def _store(path, **attributes) -> None:
+    """Settings the chain file carries, so that a resumed run uses and reports the same: the sampler's coordinates
+    (``spacepol_space``) and the start-point searches' modes (``spacepol_start_search``, JSON)."""
     import h5py
 
     with h5py.File(path, "a") as f:
-        f.attrs["spacepol_space"] = space.name
+        for name, value in attributes.items():
+            f.attrs[name] = value
 
 
-def _stored_space(path, priors) -> SamplingSpace:
+def _stored(path, name: str, default=None):
     import h5py
 
     with h5py.File(path, "r") as f:
-        name = f.attrs.get("spacepol_space", SamplingSpace.family)
-    return SamplingSpace.from_name(priors, str(name))
+        return f.attrs.get(name, default)
 
 
 def _tau_at(sampler, iteration: int, space) -> np.ndarray:
@@ -192,8 +174,10 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
     start_search = None
     if resumed:
-        space = space or _stored_space(backend_path, posterior.priors)
-        start_search = _stored_modes(backend_path)
+        space = space or SamplingSpace.from_name(posterior.priors, str(_stored(backend_path, "spacepol_space",
+                                                                               SamplingSpace.family)))
+        stored_search = _stored(backend_path, "spacepol_start_search")
+        start_search = None if stored_search is None else json.loads(str(stored_search))
     else:
         random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
         initial, modes = starting_points(posterior, rng, walkers, initial)
@@ -202,12 +186,11 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             if progress:
                 for line in modes.findings():
                     print(f"  {line}", file=sys.stderr)
-            if backend_path is not None:
-                _store_modes(backend_path, start_search)
         if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
             space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
         if backend_path is not None:
-            _store_space(backend_path, space)
+            extra = {} if start_search is None else {"spacepol_start_search": json.dumps(start_search)}
+            _store(backend_path, spacepol_space=space.name, **extra)
     sampler = emcee.EnsembleSampler(walkers, ndim, space.log_prob(posterior), vectorize=True, moves=_moves(),
                                     backend=backend)
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True

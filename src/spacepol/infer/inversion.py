@@ -76,10 +76,12 @@ def check_walkers(walkers: int | None, ndim: int) -> int:
 
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
-           backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None) -> Inversion:
+           backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None,
+           tau_multiple: float = 50.0) -> Inversion:
     """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
     around which the walkers start; by default a global optimisation finds one. ``space``: where the walkers
-    move (``sampling_space``; default the logit of each prior's CDF)."""
+    move (``sampling_space``; default the logit of each prior's CDF). ``tau_multiple``: the chain is long
+    enough at this many autocorrelation times (with R-hat <= 1.01 and ESS >= 400 besides)."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = check_walkers(walkers, posterior.ndim)
@@ -90,7 +92,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         _stamp_backend(backend_path, print_)  # before sampling, so an interrupted chain is recognised
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
-                          check_every=check_every, space=space,
+                          check_every=check_every, space=space, tau_multiple=tau_multiple,
                           initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
     if backend_path is not None:
         compact(backend_path)

@@ -37,6 +37,11 @@ _CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at o
 # of 256, 274-314 in blocks of 1,024, 357-524 in one block, interleaved in one process)
 _BATCH_SIZES = (16, 64, 256, 1024, 4096)
 _ALWAYS_UP_TO = 256
+# a likelihood whose smallest block (16 sets) holds at least this many numbers is compiled for that block and the
+# caller's exact sizes only: each compilation of a full-Mueller program costs 2-5 s on a 2-core machine (PTFE-like,
+# 325 geometries x 16 elements: 6 sizes per model, ~27 s, of a diagnose candidate's ~40 s), while a call of 16 sets
+# takes milliseconds, so the fixed cost of more calls is lost in it
+_ONE_BLOCK_NUMBERS = 1 << 15
 
 
 def _block_rows(n_sets: int, sizes: list) -> int:
@@ -119,6 +124,12 @@ class Likelihood:
         return max([size for size in _BATCH_SIZES if size <= sets] or [_BATCH_SIZES[0]])
 
     @property
+    def compiles_one_block(self) -> bool:
+        """Whether calls go through the smallest compiled block (and the caller's ``exact_sizes``) only: where one
+        block's evaluation outweighs a call's fixed cost, every other size would only add a compilation."""
+        return _BATCH_SIZES[0] * (16 if self.needs_mueller else 4) * len(self.data) >= _ONE_BLOCK_NUMBERS
+
+    @property
     def n_obs(self) -> int:
         return len(self.observables) * len(self.data)
 
@@ -185,13 +196,15 @@ class Likelihood:
         if not n_sets:
             return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
         matrix = set_matrix([v for _, v in columns], n_sets)
-        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)} | self.exact_sizes)
+        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
+                        and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
         rows = _block_rows(n_sets, sizes)
         out = []
         for i in range(0, n_sets, rows):
             block = matrix[i : i + rows]
             n = len(block)
-            size = next((s for s in sizes if s >= n), n)
+            # the last block of a long call is padded to the others' size (compiled already), not to a size of its own
+            size = rows if rows in sizes and i else next((s for s in sizes if s >= n), n)
             if size > n:  # padded with the last set (a valid one)
                 block = np.concatenate([block, np.repeat(block[-1:], size - n, axis=0)])
             out.append(np.asarray(self._jitted[key](block))[:n])

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
+from ..physics.plugin_guard import is_plugin
 from .likelihood import Likelihood
 from .measured_noise import measure
 from .prior_set import PriorSet
@@ -47,7 +48,9 @@ class Posterior:
         fixed-seed generator, so the user's random stream is untouched."""
         rng = np.random.default_rng(20261122)
         theta = np.vstack([self.priors.rescale(np.full((1, self.ndim), 0.5)), self.priors.sample(rng, draws)])
-        self.likelihood.model.check_plugins(self.model_params(theta), self.likelihood.data.geometry)
+        model = self.likelihood.model
+        if any(is_plugin(e) for e in model.effects):  # built-in effects need no guard (and a compilation of their own)
+            model.check_plugins(self.model_params(theta), self.likelihood.data.geometry)
         lp = self.priors.ln_prob(theta)
         if not np.any(np.isfinite(lp)):
             raise ParameterError(f"{where}: the prior density is zero at every one of {len(theta)} draws from it")

@@ -169,9 +169,9 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
             backend.reset(walkers, ndim)
 
     # every step evaluates half the ensemble: that size is compiled as it is (padding 18 walkers to the next
-    # compiled size, 64, tripled the cost of a full-Mueller step)
+    # compiled size, 64, tripled the cost of a full-Mueller step); the whole ensemble (the start) goes in two halves
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
-        posterior.likelihood.exact_sizes.update({walkers // 2, walkers})
+        posterior.likelihood.exact_sizes.add(walkers // 2)
     start_search = None
     if resumed:
         space = space or SamplingSpace.from_name(posterior.priors, str(_stored(backend_path, "spacepol_space",
@@ -257,7 +257,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         "steps": int(sampler.iteration), "walkers": walkers, "burn_in": burn, "thin": thin,
         "tau": [float(t) for t in tau], "tau_max": tau_max,
         "acceptance": float(np.mean(sampler.acceptance_fraction)), "capped": capped,
-        "resumed": resumed, "moves": "DE", "space": space.name,
+        "resumed": resumed, "moves": "DE", "space": space.name, "tau_multiple": tau_multiple,
     }
     if start_search is not None:
         info["start_search"] = start_search

@@ -149,3 +149,56 @@ def test_large_batches_are_blocked_and_padded_without_changing_a_value():
     alone = [lik.total({**{k: v[i : i + 1] for k, v in sets.items() if k != "rho_d"}, "rho_d": 0.2})[0] for i in picks]
     np.testing.assert_allclose(total[picks], alone, rtol=1e-12)
     assert np.all(np.isfinite(total)) and len(np.unique(total)) > n_sets // 2  # negative control: sets differ
+
+
+def _mueller_set(size: int):
+    from spacepol.physics.geometry import Geometry
+
+    rng = np.random.default_rng(3)
+    g = Geometry(rng.uniform(0, 70, size), rng.uniform(0, 75, size), rng.uniform(0, 360, size))
+    model = Model.from_string("specular+smith+subsurface+volume")
+    data = Dataset(g.theta_i, g.theta_r, g.dphi)
+    mueller = model.evaluate({"n": 1.35, "k": 0.0, "sigma": 0.3}, g, mueller=True).mueller
+    data.mueller = mueller * (1 + 0.01 * rng.standard_normal(mueller.shape))
+    data.mueller_err = np.abs(mueller) * 0.01 + 1e-3
+    data.brdf, data.brdf_err = mueller[0, 0], 0.02 * mueller[0, 0]
+    return model, data
+
+
+def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
+    """Full Mueller on 300 geometries: calls of 5, 40 and 100 sets all go through the one compiled block of 16
+    (padded with a valid set), each value equal to that set evaluated alone; a small likelihood (the negative
+    control) compiles a size per call instead."""
+    model, data = _mueller_set(300)
+    lik = Likelihood(data, model, observables=["mueller"])
+    assert lik.compiles_one_block
+    rng = np.random.default_rng(8)
+    sets = {"n": rng.uniform(1.2, 1.6, 100), "k": np.zeros(100), "sigma": rng.uniform(0.1, 0.5, 100)}
+    totals = [lik.total({k: v[:m] for k, v in sets.items()}) for m in (5, 40, 100)]
+    (key, jitted), = lik._jitted.items()
+    assert jitted._cache_size() == 1
+    alone = [lik.total({k: v[i : i + 1] for k, v in sets.items()})[0] for i in (0, 17, 99)]
+    np.testing.assert_allclose(totals[2][[0, 17, 99]], alone, rtol=1e-12)
+    np.testing.assert_allclose(totals[1], totals[2][:40], rtol=1e-12)
+    small_model, small_data = _mueller_set(20)
+    small = Likelihood(small_data, small_model, observables=["mueller"])
+    assert not small.compiles_one_block
+    for m in (5, 40, 100):
+        small.total({k: v[:m] for k, v in sets.items()})
+    (key, jitted), = small._jitted.items()
+    assert jitted._cache_size() == 3
+
+
+def test_a_fixed_index_under_the_interface_equals_the_same_index_free():
+    """n held fixed (a prior file's `n = 1.35`, compiled in as a scalar) under subsurface and volume, whose
+    interface rows then have no axis of sets: the same values as n = 1.35 given per set (this raised a
+    broadcasting error before)."""
+    model, data = _mueller_set(40)
+    rng = np.random.default_rng(2)
+    free = Posterior.build(data, model)
+    fixed = Posterior.build(data, model, {"n": Fixed(1.35)})
+    theta_fixed = fixed.priors.sample(rng, 6)
+    params = fixed.priors.to_params(theta_fixed)
+    theta_free = np.column_stack([np.full(6, 1.35) if name == "n" else params[name] * np.ones(6) for name in free.priors.names])
+    np.testing.assert_allclose(fixed.log_likelihood(theta_fixed), free.log_likelihood(theta_free), rtol=1e-12)
+    assert np.ptp(fixed.log_likelihood(theta_fixed)) > 0  # the sets differ

@@ -76,7 +76,9 @@ class Context:
         """
         # the vectors are stacked first and multiplied as whole arrays: a compiled program then computes each
         # of their entries once, where one product per element made it compute them again in every element
-        column, row = (jnp.stack(jnp.broadcast_arrays(*v)) for v in (column, row))
+        # one shape for both: with n held fixed (a scalar) the row through the interface has no axis of sets
+        entries = jnp.broadcast_arrays(*column, *row)
+        column, row = jnp.stack(entries[: len(column)]), jnp.stack(entries[len(column):])
         if self.mueller:
             return column[:, None] * row[None, :]
         return column * row[0]

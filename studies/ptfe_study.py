@@ -2,7 +2,8 @@
 sintered PTFE (T. A. Germer, Appl. Opt. 56, 9333, 2017), the whole file: every geometry, every
 wavelength, all 15 normalised Mueller elements and the BRDF.
 
-    python studies/ptfe_study.py [--wavelength-um all] [--rounds 3] [--top 1] [--joint all] [--seed 0] [--out reports/ptfe]
+    python studies/ptfe_study.py [--wavelength-um all] [--rounds 3] [--top 1] [--model paper] [--joint all]
+                                 [--hold-index 1.35] [--seed 0] [--out reports/ptfe]
 
 ``--joint all`` refits the loop's first and last models jointly over those wavelengths (n per wavelength,
 geometry shared) after a loop run at fewer wavelengths (a loop at all four costs about an hour a round here).
@@ -15,7 +16,10 @@ geometry shared) after a loop run at fewer wavelengths (a loop at all four costs
 3. n(lambda) posteriors against PTFE's known index: 1.35 at the sodium D line (Polymer Handbook, 4th ed.,
    Brandrup, Immergut and Grulke eds., Wiley 1999, section VI; sintered PTFE's crystalline and amorphous
    phases span about 1.33-1.38), weakly dispersive over 0.35-1.06 um for a fluoropolymer.
-4. What remains unexplained, said plainly (report.md).
+4. What remains unexplained, said plainly (report.md): per round the misfit = inferred noise / the noise the
+   data measure themselves (reciprocal pairs, ``infer/measured_noise.py``) per element group, the residual RMS per
+   element; with ``--hold-index 1.35`` the final model refitted with n held at PTFE's index at every wavelength,
+   and what that costs, element by element (which structure forces n away from the material's value).
 
 After each round the report is rewritten, so an interrupted study keeps what it measured.
 """
@@ -45,8 +49,8 @@ from spacepol.physics.spectral import SpectralModel  # noqa: E402
 from spacepol.report.inversion_figures import mueller_residual_figure  # noqa: E402
 
 PTFE_INDEX, PTFE_INDEX_BAND = 1.35, (1.33, 1.38)
-SOURCE = ("PTFE's index: n_D = 1.35 (Polymer Handbook, 4th ed., Brandrup, Immergut, Grulke eds., Wiley 1999); "
-          "1.33-1.38 spans its crystalline and amorphous phases")
+SOURCE = ("PTFE's index: n_D = 1.35 (Polymer Handbook, 4th ed., Brandrup, Immergut, Grulke eds., Wiley 1999; Groh & "
+          "Zimmermann, Macromolecules 24, 6660 (1991)); 1.33-1.38 spans its crystalline and amorphous phases")
 
 
 def load(wavelengths: str, in_plane: bool = False):
@@ -76,10 +80,21 @@ def index_posteriors(inv, data) -> dict:
     return {lab: p[f"n@{lab}"] for lab in labels if f"n@{lab}" in p}
 
 
+def element_rms(inv) -> dict:
+    """{channel: RMS of measured minus the posterior-median prediction} (relative for the BRDF, absolute for m_ij)."""
+    from spacepol.infer.inference_data import median_fit
+
+    lik = inv.posterior.likelihood
+    mu, _ = median_fit(inv.posterior, inv.result.flat_samples())
+    return {ch: float(np.sqrt(np.mean(np.square(lik.residual(ch, mu[ch]))))) for ch in lik.observables}
+
+
 def rung_record(step: dict, inv, data) -> dict:
     s = inv.summary
     runs = s["residual_structure"].get("runs", {})
     return {
+        "noise": {k: {f: v[f] for f in ("inferred", "measured", "ratio")} for k, v in s.get("noise", {}).items()},
+        "element_rms": element_rms(inv),
         "model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
         "delta_elpd_se": step["delta_elpd_se"], "tied_with": step.get("tied_with", []),
         "elpd_loo": s["fit"]["elpd_loo"], "elpd_loo_se": s["fit"]["elpd_loo_se"], "rmse_dop": s["fit"]["rmse_dop"],
@@ -176,6 +191,13 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     if last["at_bound"]:
         out.append("Parameters at a prior bound (the fit is unphysical there; their intervals are not measurements): "
                    + "; ".join(last["at_bound"]) + ".")
+    ratios = {k: v["ratio"] for k, v in last.get("noise", {}).items()}
+    if ratios:
+        above = {k: r for k, r in ratios.items() if r > 1.5}
+        out.append("Misfit = inferred noise / the noise the data measure themselves (reciprocal pairs): "
+                   + ", ".join(f"{k} {r:.2f}" for k, r in ratios.items())
+                   + (f": {', '.join(above)} above 1.5, so the model does not explain these elements; the inferred noise "
+                      "there is model misfit." if above else ": every group within 1.5 of the measurement's noise."))
     rec = last["reciprocity"]
     out.append(f"Reciprocity of the final model at its posterior median: BRDF changes by a median "
                f"{100 * rec['brdf_relative_median']:.1f} % (95th percentile {100 * rec['brdf_relative_p95']:.1f} %) when "
@@ -190,9 +212,21 @@ def findings(rungs: list[dict], data_recip: dict) -> list[str]:
     return out
 
 
-def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=()) -> None:
+def held_findings(final: dict, held: dict) -> list[str]:
+    """What holding n at PTFE's index costs the final model, element by element."""
+    worse = sorted(held["element_rms"], key=lambda ch: final["element_rms"][ch] - held["element_rms"][ch])
+    change = ", ".join(f"{ch} {final['element_rms'][ch]:.4f} -> {held['element_rms'][ch]:.4f}" for ch in worse[:4])
+    same = [ch for ch in held["element_rms"] if abs(held["element_rms"][ch] - final["element_rms"][ch]) < 0.1 * final["element_rms"][ch]]
+    ratios = ", ".join(f"{k} {v['ratio']:.2f}" for k, v in held.get("noise", {}).items())
+    return [f"With n held at {held['held_index']} at every wavelength, {held['model']} changes ELPD-LOO by "
+            f"{held['delta_elpd']:+.0f} +- {held['delta_elpd_se']:.0f}; the residual RMS rises most in {change}"
+            + (f"; misfit ratios {ratios}" if ratios else "")
+            + f". Within 10 % either way: {', '.join(same) or 'none'} (structure that n does not touch)."]
+
+
+def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=(), held=None) -> None:
     write_json(out / "study.json", {"meta": meta, "data_reciprocity": data_recip, "rounds": rungs, "joint": list(joint),
-                                    "complete": done})
+                                    "held_index": held, "complete": done})
     save_figure(rounds_figure(rungs), out / "rounds.png")
     save_figure(index_figure(list(joint) or rungs), out / "n_lambda.png")
     save_figure(structure_figure(rungs), out / "residual_structure.png")
@@ -205,7 +239,7 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
              "## Findings", ""] + [f"- {f}" for f in findings(rungs, data_recip)] + (
              [f"- Jointly over {meta['joint_wavelengths']} um ({joint[-1]['model']}): "
               + " ".join(f for f in findings(joint, data_recip) if f.startswith(("n < 1", "The final model's n")))]
-             if joint else []) + [
+             if joint else []) + ([f"- {f}" for f in held_findings(rungs[-1], held)] if held else []) + [
              "", "## Rounds", "",
              "| round | change | delta ELPD | ELPD-LOO | inferred noise | n(lambda) median | at bound | reciprocity (BRDF median, elements p95) |",
              "|---|---|---|---|---|---|---|---|"]
@@ -223,6 +257,21 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
             noise = ", ".join(f"{k} {v:.3g}" for k, v in r["inferred_noise"].items())
             n = ", ".join(f"{lab}: {q['median']:.3f} [{q['q05']:.3f}, {q['q95']:.3f}]" for lab, q in r["n"].items())
             lines.append(f"| {r['model']} | {r['elpd_loo']:.0f} +- {r['elpd_loo_se']:.0f} | {noise} | {n} | {'; '.join(r['at_bound']) or 'none'} |")
+    groups = list(dict.fromkeys(k for r in rungs + ([held] if held else []) for k in r.get("noise", {})))
+    if groups:
+        lines += ["", "## Misfit = inferred noise / measured noise, per element group", "",
+                  "| round | " + " | ".join(groups) + " |", "|---|" + "---|" * len(groups)]
+        for i, r in enumerate(rungs + ([held] if held else [])):
+            cells = [f"{r['noise'][g]['inferred']:.4f} / {r['noise'][g]['measured']:.4f} = {r['noise'][g]['ratio']:.2f}"
+                     if g in r.get("noise", {}) else "" for g in groups]
+            lines.append(f"| {i if r is not held else 'n held'} | " + " | ".join(cells) + " |")
+    channels = list(dict.fromkeys(ch for r in rungs for ch in r.get("element_rms", {})))
+    if channels:
+        rows = rungs + ([held] if held else [])
+        lines += ["", "## Residual RMS per element (BRDF relative), at the posterior median", "",
+                  "| model | " + " | ".join(channels) + " |", "|---|" + "---|" * len(channels)]
+        for r in rows:
+            lines.append(f"| {r['change'] or r['model']} | " + " | ".join(f"{r['element_rms'].get(ch, float('nan')):.4f}" for ch in channels) + " |")
     lines += ["", "![rounds](rounds.png)", "", "![n(lambda)](n_lambda.png)", "", "![residual structure](residual_structure.png)", "",
               "![final residuals as the Mueller matrix](final_residuals_mueller.png)", ""]
     write_text(out / "report.md", "\n".join(lines) + "\n")
@@ -237,6 +286,8 @@ def main(argv=None) -> int:
     parser.add_argument("--joint", default=None, metavar="all|LIST", help="refit the first and last models jointly here")
     parser.add_argument("--render-only", action="store_true", help="rewrite report.md and figures from OUT/study.json")
     parser.add_argument("--in-plane", action="store_true", help="the plane of incidence only (a quick look, not the study)")
+    parser.add_argument("--hold-index", type=float, default=None, metavar="N",
+                        help="refit the final model with n held at N at every wavelength (PTFE: 1.35)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="reports/ptfe")
     args = parser.parse_args(argv)
@@ -245,7 +296,8 @@ def main(argv=None) -> int:
     if args.render_only:
         saved = json.loads((out / "study.json").read_text())
         data_recip = reciprocity.data_violation(load("all", args.in_plane))
-        write_report(out, saved["meta"], saved["rounds"], data_recip, saved["complete"], saved.get("joint", ()))
+        write_report(out, saved["meta"], saved["rounds"], data_recip, saved["complete"], saved.get("joint", ()),
+                     saved.get("held_index"))
         return 0
     start = time.perf_counter()
     data = load(args.wavelength_um, args.in_plane)
@@ -273,10 +325,27 @@ def main(argv=None) -> int:
                 "minutes": (time.perf_counter() - start) / 60, "machine": "2 cores", "rows": len(data),
                 "observables": observables, "numbers": len(data) * len(observables),
                 "wavelengths": ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))}
-        write_report(out, meta, rungs, data_recip, (done or r == args.rounds - 1) and not args.joint)
+        write_report(out, meta, rungs, data_recip, (done or r == args.rounds - 1) and not args.joint and args.hold_index is None)
         print(f"round {r + 1}: {rungs[-1]['change'] or 'no change'}; report rewritten in {out}", file=sys.stderr)
         if done:
             break
+    held = None
+    if args.hold_index is not None:
+        from spacepol.infer.inversion import invert
+        from spacepol.infer.posterior import Posterior
+        from spacepol.infer.priors import Fixed
+
+        model = final.posterior.likelihood.model
+        pinned = {p.name: Fixed(args.hold_index) for p in final.posterior.priors.parameters
+                  if p.name == "n" or p.name.startswith("n@")}
+        print(f"refitting {rungs[-1]['model']} with {', '.join(pinned)} held at {args.hold_index}", file=sys.stderr)
+        inv = invert(Posterior.build(data, model, pinned), seed=args.seed, progress=False)
+        diff = inv.loo["pointwise"] - final.loo["pointwise"]
+        held = rung_record({"model": rungs[-1]["model"], "change": f"n held at {args.hold_index}",
+                            "delta_elpd": float(diff.sum()), "delta_elpd_se": float(np.sqrt(len(diff) * np.var(diff)))},
+                           inv, data) | {"held_index": args.hold_index}
+        meta["minutes"] = (time.perf_counter() - start) / 60
+        write_report(out, meta, rungs, data_recip, not args.joint, held=held)
     if args.joint:
         from spacepol.infer.inversion import invert
         from spacepol.infer.posterior import Posterior
@@ -290,7 +359,7 @@ def main(argv=None) -> int:
             joint.append(rung_record({"model": spec, "change": f"joint: {spec}", "delta_elpd": None, "delta_elpd_se": None},
                                      inv, joint_data))
             meta["minutes"] = (time.perf_counter() - start) / 60
-            write_report(out, meta, rungs, data_recip, len(joint) == 2 or rungs[0]["model"] == rungs[-1]["model"], joint)
+            write_report(out, meta, rungs, data_recip, len(joint) == 2 or rungs[0]["model"] == rungs[-1]["model"], joint, held)
     return 0
 
 

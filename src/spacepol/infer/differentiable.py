@@ -21,6 +21,10 @@ def log_likelihood_function(posterior: Posterior):
         return lambda theta: jnp.zeros(())
     names = tuple(posterior.names)
     scalars = tuple(sorted((k, float(v)) for k, v in posterior.priors.fixed.items()))
+    levels = getattr(posterior, "levels", ())  # a ProfiledPosterior's noise levels, at their maximum per set
+    if levels:
+        profiled = posterior.likelihood.function(2, names, scalars, levels)
+        return lambda theta: profiled(theta[None, :])[0, 0]
     total = posterior.likelihood.function(1, names, scalars)
     return lambda theta: total(theta[None, :])[0]
 

@@ -179,7 +179,21 @@ class Likelihood:
         """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept)."""
         return self._call(1, params)
 
-    def _call(self, which: int, params: dict) -> np.ndarray:
+    @property
+    def profilable(self) -> list[str]:
+        """The inferred noise levels whose conditional maximum is closed-form (Gaussian noise: the RMS of the
+        scaled residuals of their channels); none under the Student-t likelihood."""
+        return [] if self.robust else [p.name for p in self.nuisance]
+
+    def profiled(self, model_params: dict, levels: tuple) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """(log-likelihood per parameter set (P,), {level: (P,) values}) with each noise level in ``levels``
+        (((name, lower, upper), ...), from ``profilable``) at its conditional maximum: the RMS of its channels'
+        residuals over their noise profiles, clipped to [lower, upper] (the log-likelihood is unimodal in each
+        level, so the clipped value is the maximum inside the bounds)."""
+        out = self._call(2, model_params, tuple(levels))
+        return out[:, 0], {name: out[:, 1 + j] for j, (name, _, _) in enumerate(levels)}
+
+    def _call(self, which: int, params: dict, levels: tuple = ()) -> np.ndarray:
         """Parameter sets go in as one (P, K) matrix (one argument: a JAX call with a dict of arrays costs
         ~100 us of argument handling, more than the 84-point likelihood itself); scalars are compiled in."""
         columns, scalars, n_sets = [], {}, 0
@@ -190,7 +204,7 @@ class Likelihood:
                 v = np.asarray(v, float).reshape(-1)
                 columns.append((name, v))
                 n_sets = max(n_sets, v.size)
-        key = (which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())))
+        key = (which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())), levels)
         if key not in self._jitted:
             self._jitted[key] = self._compile(*key)
         if not n_sets:
@@ -210,13 +224,14 @@ class Likelihood:
             out.append(np.asarray(self._jitted[key](block))[:n])
         return out[0] if len(out) == 1 else np.concatenate(out, axis=0)
 
-    def _compile(self, which: int, names: tuple, scalars: tuple):
-        return jax.jit(self.function(which, names, scalars))
+    def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
+        return jax.jit(self.function(which, names, scalars, levels))
 
-    def function(self, which: int, names: tuple, scalars: tuple):
+    def function(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
         """The pure JAX function (not compiled) of a (P, len(names)) parameter matrix: the pointwise
-        log-likelihood (``which`` 0) or its sum per set (1); ``scalars``: ((name, value), ...) held fixed.
-        Gradient samplers and optimizers compose it with their own transforms and differentiate it."""
+        log-likelihood (``which`` 0), its sum per set (1), or that sum with the noise ``levels`` profiled
+        (2: (P, 1 + len(levels)), the sum and the levels; ``profiled``); ``scalars``: ((name, value), ...)
+        held fixed. Gradient samplers and optimizers compose it with their own transforms and differentiate it."""
         if self._program is None:
             self._program = Program(self.model, self.geometry, self.needs_mueller,
                                     up_to_scale=all(o.scale_free for o in self.objects))
@@ -228,30 +243,57 @@ class Likelihood:
         errors = {ch: jnp.asarray(e) for ch, e in self._errors.items()}
         profiles = {ch: jnp.asarray(f) for ch, f in self._profile.items()}
 
-        def channel_blocks(matrix):
-            """The log-likelihood of each channel, (P, N) each, in ``self.observables``' order."""
-            values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
+        if levels and self.robust:
+            raise ValueError("noise levels are profiled under the Gaussian likelihood only (robust=False)")
+        profiled_names = [name for name, _, _ in levels]
+
+        def residuals(values):
+            """Each channel's residuals, (P, N) or broadcastable, in ``self.observables``' order."""
             total, dop = program({k: v for k, v in values.items() if k in model_names}, program.inputs)
             prediction = Prediction.from_total(total, dop, mueller)
             predicted = {}
             for o in self.objects:
                 predicted.update(o.predict(prediction))
+            return [self._owner[ch].residual(ch, y[ch], predicted[ch], self.inferred(ch)) for ch in self.observables]
+
+        def profile_levels(values, resids, n_sets):
+            """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
+            out = []
+            for name, lower, upper in levels:
+                squares, count = 0.0, 0
+                for ch, resid in zip(self.observables, resids):
+                    if ch not in errors and self.noise_parameter(ch) == name:
+                        z = resid / profiles.get(ch, 1.0)
+                        squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
+                        count += len(self.data)
+                out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
+            return out
+
+        def channel_blocks(matrix, profiled=()):
+            """The log-likelihood of each channel, (P, N) each, in ``self.observables``' order; ``profiled``:
+            the levels' values (P,) each, in ``levels``' order."""
+            values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
+            resids = residuals(values)
+            if levels:
+                profiled = profile_levels(values, resids, matrix.shape[0])
+                values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
             blocks = []
-            for ch in self.observables:
+            for ch, resid in zip(self.observables, resids):
                 scale = errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0)
-                resid = self._owner[ch].residual(ch, y[ch], predicted[ch], self.inferred(ch))
                 lp = self._logpdf(ch, resid, scale)
                 blocks.append(jnp.broadcast_to(lp, jnp.broadcast_shapes(jnp.shape(lp), (matrix.shape[0], len(self.data)))))
-            return blocks
+            return blocks, profiled
 
         def pointwise(matrix):
-            return jnp.concatenate(channel_blocks(matrix), axis=-1)
+            return jnp.concatenate(channel_blocks(matrix)[0], axis=-1)
 
         def summed(matrix):
             # the channels added element by element, then one sum over the rows: one reduction (summed from a
             # concatenation, XLA stored every Mueller element and reduced each channel in a partitioned loop of
             # its own: 32 loops and their hand-overs between threads per call, 16 of them reductions)
-            return sum(channel_blocks(matrix)).sum(axis=-1)
+            blocks, profiled = channel_blocks(matrix)
+            value = sum(blocks).sum(axis=-1)
+            return jnp.stack([value, *profiled], axis=-1) if levels else value
 
         def total(matrix):
             # chunks of sets small enough that the sets x geometries intermediates stay in the CPU's cache:
@@ -262,7 +304,8 @@ class Likelihood:
             if chunk >= n_sets:
                 return summed(matrix)
             blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
-            return jax.lax.map(summed, blocks).reshape(n_sets)
+            out = jax.lax.map(summed, blocks)
+            return out.reshape((n_sets,) + out.shape[2:])
 
         return pointwise if which == 0 else total
 

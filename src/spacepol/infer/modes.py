@@ -1,8 +1,10 @@
 """Where the sampler starts: independent searches for the posterior's maximum until they agree.
 
-One global search (``optimum.find_optimum``: differential evolution, the effects' branches, a Sobol multistart)
-can end in a local mode: on NIST's PTFE with four wavelengths the default seed's search stopped ~6,000 log units
-below the mode another seed found, and emcee, started there, reported a converged posterior of the wrong mode.
+One global search (``optimum.find_optimum_profiled``: differential evolution, the effects' branches, Sobol
+multistarts, on the posterior with its noise levels profiled out, then polished on the full posterior) can end in a
+local mode: on NIST's PTFE with four wavelengths the default seed's search (then without profiling) stopped ~6,000
+log units below the mode another seed found, and emcee, started there, reported a converged posterior of the wrong
+mode.
 So the searches are repeated with independent random streams until the best mode has been reached by
 ``agreeing`` of them (at least ``min_searches`` searches, at most ``max_searches``). A better mode is missed only
 if none of the first ``min_searches`` searches finds it: with a chance p of one search finding it, (1 - p)^3
@@ -103,10 +105,10 @@ def _where(search: ModeSearch, other: Mode) -> str:
 def search_modes(posterior, rng: np.random.Generator, evaluations: int = 3000, min_searches: int = 3,
                  max_searches: int = 6, agreeing: int = 2, search=None) -> ModeSearch:
     """Independent global searches (``search(posterior, rng, evaluations) -> (log posterior, theta)``, by default
-    ``optimum.find_optimum``), each with its own stream drawn from ``rng``, until the best mode has been found by
+    ``optimum.find_optimum_profiled``), each with its own stream drawn from ``rng``, until the best mode has been found by
     ``agreeing`` searches (and at least ``min_searches`` ran), or ``max_searches`` ran."""
     if search is None:
-        from .optimum import find_optimum as search
+        from .optimum import find_optimum_profiled as search
     result = ModeSearch(list(posterior.priors.names), agreeing=agreeing)
     streams = rng.spawn(max_searches)
     for stream in streams:

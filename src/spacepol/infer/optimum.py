@@ -13,6 +13,14 @@ Three searches, the best (by the full posterior) wins:
   at 0.25 um: DE -443, multistart +845 in log posterior, the truth +841).
 DE stays: it is the cheapest of the three (0.04 s on 84 points) and on the ridge sets it finds the optimum
 every time; the multistart is what finds films and PTFE's optimum (``benchmarks/optimum_speed.py``).
+
+Where the sampler starts (``find_optimum_profiled``, run by ``modes.search_modes``), the same searches climb the
+posterior with its noise levels profiled out (``profiled``), a multistart runs on each branch too, and every
+search's optimum is polished on the full posterior. On PTFE at four wavelengths (``paper+polarized_diffuse``)
+9 plain searches (3 seeds x 3 streams) ended in four different modes, 2 of them in the best they found (266,109)
+and none in the best there is (267,049); 8 of 9 profiled searches end there, ~56 s each on 2 cores
+(``/tmp``-free record: reports/benchmarks.md, session 15). Profiling alone is not what finds it: the cube's
+profiled optimum is the 261,044 mode, and only the dielectric branch's multistart, polished in full, leaves it.
 """
 
 from __future__ import annotations
@@ -25,6 +33,7 @@ from .engines.de import run_de
 from .objective import NegativeLogPosterior
 from .posterior import Posterior
 from .priors import Fixed
+from .profiled import ProfiledPosterior
 
 
 def _branches(posterior: Posterior):
@@ -40,27 +49,59 @@ def _branches(posterior: Posterior):
             overrides = {name: prior for name, prior in priors.priors.items() if name not in pinned}
             overrides.update({n: Fixed(float(v)) for n, v in pinned.items()})
             sub = type(priors)(priors.parameters, overrides, where=f"{effect.name} branch {pinned}")
-            yield pinned, Posterior(posterior.likelihood, sub, prior_only=posterior.prior_only)
+            yield pinned, posterior.with_priors(sub)
 
 
 def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: int = 4000, seeds=None,
-                 popsize: int = 10) -> tuple[float, np.ndarray]:
-    """(max log posterior, parameter vector in ``posterior.priors.names`` order)."""
+                 popsize: int = 10, branch_multistart: bool = False) -> tuple[float, np.ndarray]:
+    """(max log posterior, parameter vector in ``posterior.priors.names`` order): the best of ``candidates``."""
+    return max(candidates(posterior, rng, evaluations, seeds, popsize, branch_multistart), key=lambda c: c[0])
+
+
+def candidates(posterior: Posterior, rng: np.random.Generator, evaluations: int = 4000, seeds=None, popsize: int = 10,
+               branch_multistart: bool = False) -> list[tuple[float, np.ndarray]]:
+    """The optimum each search found, as (log posterior, full parameter vector): DE on the prior cube, DE on each
+    effect's branch (and a multistart there, with ``branch_multistart``), the multistart on the cube."""
     res = run_de(NegativeLogPosterior(posterior), rng, max_evaluations=evaluations, popsize=popsize, polish=True, seeds=seeds)
-    best_value, best = -res.objective, res.best_vector()
+    found = [(-float(res.objective), res.best_vector())]
     for pinned, branch in _branches(posterior):
         keep = [j for j, n in enumerate(posterior.priors.names) if n not in pinned]
         sub_seeds = None if seeds is None else np.atleast_2d(seeds)[:, keep]
         sub = run_de(NegativeLogPosterior(branch), rng, max_evaluations=evaluations, popsize=popsize, polish=True, seeds=sub_seeds)
-        values = {**sub.best, **pinned}
-        theta = np.array([values[n] for n in posterior.priors.names])
-        value = float(posterior.log_prob(theta[None, :])[0])
-        if value > best_value:
-            best_value, best = value, theta
-    value, theta = multistart(posterior, rng)
-    if value > best_value:
-        best_value, best = value, theta
-    return best_value, best
+        searched = [sub.best_vector()]
+        if branch_multistart:
+            searched.append(multistart(branch, rng)[1])
+        for vector in searched:
+            values = {**dict(zip(branch.priors.names, vector)), **pinned}
+            theta = np.array([values[n] for n in posterior.priors.names])
+            found.append((float(posterior.log_prob(theta[None, :])[0]), theta))
+    found.append(multistart(posterior, rng))
+    return found
+
+
+def find_optimum_profiled(posterior: Posterior, rng: np.random.Generator, evaluations: int = 4000) -> tuple[float, np.ndarray]:
+    """The searches of ``candidates`` (with a multistart on each branch) over the model's parameters, the noise
+    levels at their conditional maximum (``profiled``); then the full posterior polished from each search's optimum:
+    (max log posterior, parameter vector). A branch's optimum is polished too, though its profiled value is below
+    the cube's: on PTFE (four wavelengths) the dielectric branch's polish ends ~6,000 log units above the cube's.
+    Without a level to profile, ``find_optimum`` itself."""
+    profiled = ProfiledPosterior.of(posterior)
+    if profiled is None:
+        return find_optimum(posterior, rng, evaluations, branch_multistart=True)
+    found = candidates(profiled, rng, evaluations, branch_multistart=True)
+    return max((polish_posterior(posterior, profiled.complete(theta)[0]) for _, theta in found), key=lambda c: c[0])
+
+
+def polish_posterior(posterior: Posterior, theta) -> tuple[float, np.ndarray]:
+    """The local maximum of the log posterior nearest ``theta`` (L-BFGS-B in the prior cube): (value, vector);
+    ``theta`` itself where the polish does not improve on it."""
+    objective, priors = NegativeLogPosterior(posterior), posterior.priors
+    theta = np.asarray(theta, float)
+    start_value = float(posterior.log_prob(theta[None, :])[0])
+    value, u = local_search.polish(lambda u: objective(priors.rescale(np.clip(u, 0.0, 1.0))), priors.to_unit(theta[None, :])[0])
+    polished = priors.rescale(u[None, :])[0]
+    value = float(posterior.log_prob(polished[None, :])[0])
+    return (value, polished) if value > start_value or not np.isfinite(start_value) else (start_value, theta)
 
 
 # ``gradient=None``: above this many numbers x (parameters + 1) a finite-difference gradient (one batch of D + 1

@@ -62,6 +62,10 @@ class Posterior:
                 f"{self.likelihood.data.source}: the likelihood is not finite at any of {len(theta)} draws from the "
                 f"priors ({where}); the model cannot produce these data anywhere the priors allow")
 
+    def with_priors(self, priors: PriorSet) -> "Posterior":
+        """The same likelihood under other priors (e.g. a parameter pinned on an effect's branch)."""
+        return Posterior(self.likelihood, priors, prior_only=self.prior_only)
+
     @property
     def ndim(self) -> int:
         return self.priors.ndim

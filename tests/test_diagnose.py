@@ -62,12 +62,26 @@ def _case_report(case, candidates=None, top=3):
                     candidates=candidates, top=top, progress=False)
 
 
-def test_null_set_gets_verdict_none_with_the_whole_library():
-    """Fast version of the null half of the validation suite: no hidden effect, nothing significant."""
+def _null_case():
     from spacepol.criticism.hidden_effects import suite
 
-    null = [c for c in suite() if c.effect is None][0]
-    report = _case_report(null)
+    return [c for c in suite() if c.effect is None][0]
+
+
+def test_null_set_gets_verdict_none_from_the_most_flexible_candidates():
+    """Fast version of the null half of the validation suite: no hidden effect, nothing significant among the
+    candidates with the most freedom to absorb noise (a second diffuse lobe, a DOP offset, an extra term)."""
+    candidates = ["polarized_diffuse", "lambertian", "dop_bias", "extinction"]
+    report = _case_report(_null_case(), candidates=candidates)
+    assert report["verdict"] == "none", report["ranking"][:3]
+    assert set(candidates) <= {r["effect"] for r in report["ranking"]}, [r["effect"] for r in report["ranking"]]
+    assert "nothing is missing" in report["conclusion"]
+
+
+@pytest.mark.slow
+def test_null_set_gets_verdict_none_with_the_whole_library():
+    """The null half of the validation suite with every candidate (false alarms multiply with their number)."""
+    report = _case_report(_null_case())
     assert report["verdict"] == "none", report["ranking"][:3]
     assert len(report["ranking"]) >= 8  # every composable built-in effect was screened (oxide_layer too: 0.633 um)
     assert "nothing is missing" in report["conclusion"]

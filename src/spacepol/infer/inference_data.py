@@ -16,6 +16,9 @@ from .result import Result
 # draws are thinned for them (never below _MIN_POINTWISE_DRAWS): PSIS-LOO needs hundreds of draws, not 10^4.
 _POINTWISE_VALUES = 40_000_000
 _MIN_POINTWISE_DRAWS = 800
+# a posterior median prediction from at most this many evenly thinned draws: its Monte-Carlo error is then below
+# 4 % of the posterior SD, and on a 278-geometry full-Mueller set each median took 1.6 s from 9,000 draws
+_MEDIAN_DRAWS = 1000
 
 
 def _batched(fn, flat, batch: int):
@@ -52,9 +55,9 @@ def noise_scales(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
 
 
 def median_fit(posterior: Posterior, samples):
-    """Posterior-median prediction and noise level per channel: ({ch: (N,)}, {ch: (N,)}). On large data
-    sets from evenly thinned samples (``pointwise_thinning``)."""
-    samples = samples[:: pointwise_thinning(len(samples), 1, posterior.likelihood.n_obs)]
+    """Posterior-median prediction and noise level per channel: ({ch: (N,)}, {ch: (N,)}), from at most
+    ``_MEDIAN_DRAWS`` evenly thinned samples."""
+    samples = samples[:: max(1, int(np.ceil(len(samples) / _MEDIAN_DRAWS)))]
     means, scales = predictive_means(posterior, samples), noise_scales(posterior, samples)
     return ({o: np.median(m, axis=0) for o, m in means.items()}, {o: np.median(v, axis=0) for o, v in scales.items()})
 
@@ -71,13 +74,18 @@ def replicate(posterior: Posterior, means, scales, rng: np.random.Generator):
     return {ch: lik.replicate(ch, mu, scales[ch], rng) for ch, mu in means.items()}
 
 
-def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Generator) -> az.InferenceData:
+def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Generator,
+                      max_pointwise_draws: int | None = None) -> az.InferenceData:
+    """The run as ArviZ groups; the pointwise groups (log_likelihood, posterior_predictive) from every k-th draw
+    (``pointwise_thinning``), at most ``max_pointwise_draws`` draws in all when given."""
     samples = result.samples  # (draws, chains, D)
     draws, chains, ndim = samples.shape
     lik = posterior.likelihood
     n = len(lik.data)
     flat = samples.transpose(1, 0, 2).reshape(-1, ndim)  # chain-major
     step = pointwise_thinning(draws, chains, lik.n_obs)
+    if max_pointwise_draws:
+        step = max(step, int(np.ceil(draws * chains / max_pointwise_draws)))
     kept = len(range(0, draws, step))
     flat_kept = samples[::step].transpose(1, 0, 2).reshape(-1, ndim)
     loglik = _batched(posterior.log_prob_pointwise, flat_kept, lik.batch_sets)  # (S', M)

@@ -77,11 +77,12 @@ def check_walkers(walkers: int | None, ndim: int) -> int:
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
            backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None,
-           tau_multiple: float = 50.0) -> Inversion:
+           tau_multiple: float = 50.0, max_pointwise_draws: int | None = None) -> Inversion:
     """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
     around which the walkers start; by default a global optimisation finds one. ``space``: where the walkers
     move (``sampling_space``; default the logit of each prior's CDF). ``tau_multiple``: the chain is long
-    enough at this many autocorrelation times (with R-hat <= 1.01 and ESS >= 400 besides)."""
+    enough at this many autocorrelation times (with R-hat <= 1.01 and ESS >= 400 besides).
+    ``max_pointwise_draws``: PSIS-LOO and the posterior predictive from at most this many draws."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = check_walkers(walkers, posterior.ndim)
@@ -96,7 +97,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
                           initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
     if backend_path is not None:
         compact(backend_path)
-    idata = to_inference_data(result, posterior, rng)
+    idata = to_inference_data(result, posterior, rng, max_pointwise_draws)
     loo_result = loo(idata)
     summary = {
         "model": posterior.likelihood.model.name,

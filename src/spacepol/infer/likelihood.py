@@ -116,18 +116,23 @@ class Likelihood:
         self.exact_sizes: set[int] = set()
 
     @property
+    def numbers_per_set(self) -> int:
+        """Values one parameter set's evaluation holds over the geometries: 16 Mueller or 4 Stokes elements each."""
+        return (16 if self.needs_mueller else 4) * len(self.data)
+
+    @property
     def batch_sets(self) -> int:
         """How many parameter sets one vectorised evaluation should take: intermediate arrays of
         sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); one of the
         sizes the likelihood is compiled for."""
-        sets = 4_000_000 // ((16 if self.needs_mueller else 4) * len(self.data))
+        sets = 4_000_000 // self.numbers_per_set
         return max([size for size in _BATCH_SIZES if size <= sets] or [_BATCH_SIZES[0]])
 
     @property
     def compiles_one_block(self) -> bool:
         """Whether calls go through the smallest compiled block (and the caller's ``exact_sizes``) only: where one
         block's evaluation outweighs a call's fixed cost, every other size would only add a compilation."""
-        return _BATCH_SIZES[0] * (16 if self.needs_mueller else 4) * len(self.data) >= _ONE_BLOCK_NUMBERS
+        return _BATCH_SIZES[0] * self.numbers_per_set >= _ONE_BLOCK_NUMBERS
 
     @property
     def n_obs(self) -> int:
@@ -299,7 +304,7 @@ class Likelihood:
             # chunks of sets small enough that the sets x geometries intermediates stay in the CPU's cache:
             # above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2 at 64)
             n_sets = matrix.shape[0]
-            chunk = min(n_sets, max(1, _CACHE_NUMBERS // ((16 if mueller else 4) * len(self.data))))
+            chunk = min(n_sets, max(1, _CACHE_NUMBERS // self.numbers_per_set))
             chunk = next(c for c in range(chunk, 0, -1) if n_sets % c == 0)  # the largest that divides the batch
             if chunk >= n_sets:
                 return summed(matrix)

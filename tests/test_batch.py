@@ -19,7 +19,6 @@ from spacepol.physics.geometry import default_grid
 TRUTHS = {
     "glossy_metal": {"n": 1.2, "k": 3.0, "sigma": 0.15, "ks": 0.6, "rho_d": 0.05},
     "paint": {"n": 1.5, "k": 0.0, "sigma": 0.3, "ks": 0.4, "rho_d": 0.3},
-    "rough_dielectric": {"n": 1.8, "k": 0.1, "sigma": 0.45, "ks": 0.8, "rho_d": 0.15},
 }
 NOISE_DOP, NOISE_BRDF = 0.004, 0.02
 
@@ -127,7 +126,7 @@ def test_bad_manifests_are_one_line_exit_2_and_leave_nothing(tmp_path, text, wor
 def test_local_pool_from_the_command_line(manifest, tmp_path):
     """The default executor (a spawned process pool), through the CLI: exit 1 when a set failed, table written."""
     keep = manifest.read_text().splitlines()
-    manifest.write_text("\n".join([keep[0], keep[2], keep[4]]) + "\n")  # paint and broken
+    manifest.write_text("\n".join([keep[0], keep[2], keep[3]]) + "\n")  # paint and broken
     run = subprocess.run([sys.executable, "-m", "spacepol.cli", "batch", str(manifest), "--out", str(tmp_path / "o"),
                           "--workers", "2"], capture_output=True, text=True)
     assert run.returncode == 1, run.stderr

@@ -87,6 +87,7 @@ def test_null_set_gets_verdict_none_with_the_whole_library():
     assert "nothing is missing" in report["conclusion"]
 
 
+@pytest.mark.slow  # 50 s; the same tie and its explanation: test_mueller_criticism's DOP+BRDF test, in the default run
 def test_twins_are_reported_with_the_measurement_that_separates_them():
     """Hidden extinction: depolarization predicts the same DOP and BRDF (the body lobe is depolarized)."""
     from spacepol.criticism.hidden_effects import Case, score

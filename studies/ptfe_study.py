@@ -257,17 +257,17 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
             noise = ", ".join(f"{k} {v:.3g}" for k, v in r["inferred_noise"].items())
             n = ", ".join(f"{lab}: {q['median']:.3f} [{q['q05']:.3f}, {q['q95']:.3f}]" for lab, q in r["n"].items())
             lines.append(f"| {r['model']} | {r['elpd_loo']:.0f} +- {r['elpd_loo_se']:.0f} | {noise} | {n} | {'; '.join(r['at_bound']) or 'none'} |")
-    groups = list(dict.fromkeys(k for r in rungs + ([held] if held else []) for k in r.get("noise", {})))
+    rows = rungs + ([held] if held else [])
+    groups = list(dict.fromkeys(k for r in rows for k in r.get("noise", {})))
     if groups:
         lines += ["", "## Misfit = inferred noise / measured noise, per element group", "",
                   "| round | " + " | ".join(groups) + " |", "|---|" + "---|" * len(groups)]
-        for i, r in enumerate(rungs + ([held] if held else [])):
+        for i, r in enumerate(rows):
             cells = [f"{r['noise'][g]['inferred']:.4f} / {r['noise'][g]['measured']:.4f} = {r['noise'][g]['ratio']:.2f}"
                      if g in r.get("noise", {}) else "" for g in groups]
             lines.append(f"| {i if r is not held else 'n held'} | " + " | ".join(cells) + " |")
     channels = list(dict.fromkeys(ch for r in rungs for ch in r.get("element_rms", {})))
     if channels:
-        rows = rungs + ([held] if held else [])
         lines += ["", "## Residual RMS per element (BRDF relative), at the posterior median", "",
                   "| model | " + " | ".join(channels) + " |", "|---|" + "---|" * len(channels)]
         for r in rows:

@@ -20,12 +20,14 @@ SEEDS = range(30)
 
 class TwoModes:
     """A posterior-like object with what the searches use: priors, names, ndim, log_prob and a likelihood with
-    no effects (no branches), a batch size and an observation count."""
+    no effects (no branches), a batch size, an observation count and no noise level to profile."""
+
+    prior_only = False
 
     def __init__(self, width=0.002):
         self.priors = PriorSet([Parameter("a", "", Uniform(0.0, 1.0), 0.5, "a"), Parameter("b", "", Uniform(0.0, 1.0), 0.5, "b")])
         self.names, self.ndim, self.width = self.priors.names, 2, width
-        self.likelihood = SimpleNamespace(model=SimpleNamespace(effects=[]), batch_sets=4096, n_obs=100)
+        self.likelihood = SimpleNamespace(model=SimpleNamespace(effects=[]), batch_sets=4096, n_obs=100, profilable=[])
 
     def log_prob(self, theta):
         t = np.atleast_2d(theta)

@@ -261,7 +261,7 @@ class Likelihood:
                 predicted.update(o.predict(prediction))
             return [self._owner[ch].residual(ch, y[ch], predicted[ch], self.inferred(ch)) for ch in self.observables]
 
-        def profile_levels(values, resids, n_sets):
+        def profile_levels(resids, n_sets):
             """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
             out = []
             for name, lower, upper in levels:
@@ -274,14 +274,13 @@ class Likelihood:
                 out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
             return out
 
-        def channel_blocks(matrix, profiled=()):
-            """The log-likelihood of each channel, (P, N) each, in ``self.observables``' order; ``profiled``:
-            the levels' values (P,) each, in ``levels``' order."""
+        def channel_blocks(matrix):
+            """(the log-likelihood of each channel, (P, N) each, in ``self.observables``' order; the profiled
+            levels' values, (P,) each, in ``levels``' order)."""
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
             resids = residuals(values)
-            if levels:
-                profiled = profile_levels(values, resids, matrix.shape[0])
-                values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
+            profiled = profile_levels(resids, matrix.shape[0]) if levels else []
+            values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
             blocks = []
             for ch, resid in zip(self.observables, resids):
                 scale = errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0)

@@ -16,11 +16,10 @@ every time; the multistart is what finds films and PTFE's optimum (``benchmarks/
 
 Where the sampler starts (``find_optimum_profiled``, run by ``modes.search_modes``), the same searches climb the
 posterior with its noise levels profiled out (``profiled``), a multistart runs on each branch too, and every
-search's optimum is polished on the full posterior. On PTFE at four wavelengths (``paper+polarized_diffuse``)
-9 plain searches (3 seeds x 3 streams) ended in four different modes, 2 of them in the best they found (266,109)
-and none in the best there is (267,049); 8 of 9 profiled searches end there, ~56 s each on 2 cores
-(``/tmp``-free record: reports/benchmarks.md, session 15). Profiling alone is not what finds it: the cube's
-profiled optimum is the 261,044 mode, and only the dielectric branch's multistart, polished in full, leaves it.
+search's optimum is polished on the full posterior. On PTFE at four wavelengths (``paper+polarized_diffuse``) no
+plain search of 9 reached the best mode and 6-8 of 9 profiled ones do (``benchmarks/start_search_modes.py``,
+reports/benchmarks.md). Profiling alone is not what finds it: the cube's profiled optimum is a mode ~6,000 log
+units lower, and only the dielectric branch's multistart, polished in full, leaves it.
 """
 
 from __future__ import annotations
@@ -98,9 +97,9 @@ def polish_posterior(posterior: Posterior, theta) -> tuple[float, np.ndarray]:
     objective, priors = NegativeLogPosterior(posterior), posterior.priors
     theta = np.asarray(theta, float)
     start_value = float(posterior.log_prob(theta[None, :])[0])
-    value, u = local_search.polish(lambda u: objective(priors.rescale(np.clip(u, 0.0, 1.0))), priors.to_unit(theta[None, :])[0])
+    negative, u = local_search.polish(lambda u: objective(priors.rescale(np.clip(u, 0.0, 1.0))), priors.to_unit(theta[None, :])[0])
     polished = priors.rescale(u[None, :])[0]
-    value = float(posterior.log_prob(polished[None, :])[0])
+    value = -negative if negative < 1e300 else -np.inf  # NegativeLogPosterior's stand-in for a non-finite value
     return (value, polished) if value > start_value or not np.isfinite(start_value) else (start_value, theta)
 
 

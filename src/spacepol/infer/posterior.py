@@ -96,10 +96,14 @@ class Posterior:
         if np.any(inside):
             # every row is evaluated (those outside the priors are discarded after): a fixed batch size is
             # one compiled program, where the varying count of rows inside would compile one per size
-            ll = self.likelihood.total(self.priors.to_params(theta))[inside]
+            ll = self.summed_log_likelihood(theta)[inside]
             self.n_evaluations += int(inside.sum())
             out[inside] = np.where(np.isfinite(ll), ll, -np.inf)
         return out
+
+    def summed_log_likelihood(self, theta) -> np.ndarray:
+        """The likelihood's sum per row of theta (W, D), every row evaluated (``log_likelihood`` masks)."""
+        return self.likelihood.total(self.priors.to_params(theta))
 
     def __call__(self, theta):
         return self.log_prob(theta)

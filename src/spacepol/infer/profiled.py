@@ -30,10 +30,10 @@ class ProfiledPosterior(Posterior):
     def of(cls, posterior: Posterior) -> "ProfiledPosterior | None":
         """The profiled form of ``posterior``, or None when no free noise level can be profiled (errors in the
         file, fixed levels, a Student-t likelihood, a prior-only posterior)."""
-        if getattr(posterior, "prior_only", False):
+        if posterior.prior_only:
             return None
         priors = posterior.priors
-        names = [n for n in getattr(posterior.likelihood, "profilable", ()) if n in priors.names]
+        names = [n for n in posterior.likelihood.profilable if n in priors.names]
         if not names or len(names) == priors.ndim:
             return None
         kept = [p for p in priors.parameters if p.name not in names]
@@ -44,17 +44,9 @@ class ProfiledPosterior(Posterior):
         """The same profiled posterior under other priors for the parameters kept (an effect's branch)."""
         return ProfiledPosterior(self.likelihood, priors, self.levels, self.full)
 
-    def log_likelihood(self, theta, inside=None) -> np.ndarray:
-        """The log-likelihood of each row of theta (W, D) at its profiled noise levels; -inf where not finite
-        and in the rows not ``inside``."""
-        theta = np.atleast_2d(theta)
-        inside = np.ones(len(theta), bool) if inside is None else inside
-        out = np.full(len(theta), -np.inf)
-        if np.any(inside):
-            ll, _ = self.likelihood.profiled(self.priors.to_params(theta), self.levels)
-            self.n_evaluations += int(inside.sum())
-            out[inside] = np.where(np.isfinite(ll[inside]), ll[inside], -np.inf)
-        return out
+    def summed_log_likelihood(self, theta) -> np.ndarray:
+        """The log-likelihood of each row of theta (W, D) at its profiled noise levels."""
+        return self.likelihood.profiled(self.priors.to_params(theta), self.levels)[0]
 
     def complete(self, theta) -> np.ndarray:
         """The full posterior's parameter vectors (rows in ``full.priors.names`` order) for rows of theta: the

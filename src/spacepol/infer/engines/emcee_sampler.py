@@ -10,7 +10,8 @@
   81-99 to ~30 steps (``benchmarks/inversion_speed.py``).
 * Moves: differential evolution (80 %) and DE snooker (20 %): DE moves follow the long ridges that
   DOP-only data leave (k_s against rho_d). In the logit space the stretch move needed tau ~ 80, DE
-  alone ~ 40, DE + snooker ~ 30 at 1.4x DE's cost per step: about equal per second.
+  alone ~ 40, DE + snooker ~ 30 at 1.4x DE's cost per step: about equal per second. The snooker is
+  ``snooker.DESnookerMove``: emcee's own does not keep the posterior (too narrow).
 * Length: the chain grows in blocks of ``check_every`` steps (at absolute multiples, so a
   resumed run makes the same decisions) until it is longer than ``tau_multiple`` times the
   largest integrated autocorrelation time and that estimate has settled (changed < 5 % over
@@ -36,6 +37,7 @@ import numpy as np
 from ..buffered_backend import BufferedHDFBackend
 from ..result import Result
 from ..sampling_space import SamplingSpace, reaching_a_bound
+from .snooker import DESnookerMove
 
 
 def default_walkers(ndim: int) -> int:
@@ -112,7 +114,7 @@ def starting_points(posterior, rng, count: int, initial=None):
 
 
 def _moves():
-    return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    return [(emcee.moves.DEMove(), 0.8), (DESnookerMove(), 0.2)]
 
 
 def _store(path, **attributes) -> None:

@@ -51,7 +51,7 @@ def test_spectral_model_names_one_copy_per_wavelength_and_shares_the_rest():
 def cauchy_fit():
     data = _cauchy_set()
     post = Posterior.build(data, SpectralModel(Model.from_string(BASE), LAMBDAS, {"n": "cauchy"}))
-    return invert(post, seed=3, progress=False, max_steps=12000)
+    return invert(post, seed=3, progress=False, max_steps=20000)
 
 
 def test_a_cauchy_law_is_recovered_from_four_wavelengths(cauchy_fit):

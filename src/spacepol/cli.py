@@ -121,6 +121,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--top", type=_int_at_least(1), default=3, help="candidates confirmed by a full refit")
     p.add_argument("--rounds", type=_int_at_least(1), default=None, metavar="N",
                    help="accept the best significant change and continue from the changed model, up to N rounds")
+    p.add_argument("--posterior", choices=("laplace", "emcee"), default="laplace",
+                   help="each fit's posterior: a Laplace approximation corrected by importance sampling where its Pareto k "
+                        "trusts it, else emcee (default), or emcee always")
     p.add_argument("--out", default="reports/diagnose")
 
     p = sub.add_parser("ladder", help="fit M, M + E1, M + E1 + E2, ...: the error falling rung by rung")

@@ -356,14 +356,14 @@ def diagnose(args) -> int:
         from .criticism.rounds import as_rungs, diagnose_rounds
 
         result = diagnose_rounds(data, model, rng, args.rounds, seed=args.seed, observables=observables,
-                                 candidates=args.candidates, top=args.top, priors=priors)
+                                 candidates=args.candidates, top=args.top, priors=priors, posterior_method=args.posterior)
         rungs = as_rungs(result)
         first = result.pop("_reports")[0]
         report = result
         base, confirmed = first["_base"], first["_confirmed"]
     else:
         report = run_diagnose(data, model, rng, seed=args.seed, observables=observables,
-                              candidates=args.candidates, top=args.top, priors=priors)
+                              candidates=args.candidates, top=args.top, priors=priors, posterior_method=args.posterior)
         base, confirmed = report.pop("_base"), report.pop("_confirmed")
         rungs = None
     write_diagnose_report(report, base, confirmed, Path(args.out), str(args.data), path_rungs=rungs)

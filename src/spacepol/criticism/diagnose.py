@@ -1,11 +1,12 @@
 """What is missing or wrong in a model: screen every change (add, replace, remove), confirm the leaders.
 
-1. Fit the model M (emcee) and keep its pointwise PSIS-LOO.
+1. Fit the model M and keep its pointwise PSIS-LOO (each fit: a Laplace approximation corrected by importance
+   sampling where its Pareto k trusts it, else emcee; ``fit_for_elpd``).
 2. Screening: for every change of M (``criticism.changes``: each registered effect added, each
    slot member replaced by another of its slot, each removable effect removed; built-ins and
    plug-ins alike), a quick global maximum of the log posterior of the changed model; the gain
    over M's maximum (a likelihood-ratio statistic) ranks the candidates.
-3. Confirmation: the ``top`` candidates are refitted with emcee; the change in ELPD-LOO and its
+3. Confirmation: the ``top`` candidates are refitted (as M); the change in ELPD-LOO and its
    standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4.
 4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
    explanation says what measurement separates them (as the effects declare it). Effects declared
@@ -25,7 +26,7 @@ from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
-from ..infer.inversion import explains, invert
+from ..infer.inversion import explains, invert, invert_laplace
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
@@ -66,11 +67,13 @@ def _vector(values: dict, posterior) -> np.ndarray:
 
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
-             priors: dict | None = None, base=None, confirm=(), simplifications: int = 0) -> dict:
+             priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
+             posterior_method: str = "laplace") -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
     ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted); ``confirm``:
     change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
-    parameters to refit besides (for diagnose --rounds, which may take one when nothing is significant)."""
+    parameters to refit besides (for diagnose --rounds, which may take one when nothing is significant);
+    ``posterior_method``: how each fit's posterior is drawn (``fit_for_elpd``)."""
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     base_post = _build(data, model, observables, priors)
@@ -78,9 +81,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     all_candidates = changes(model, data, candidates)
     if base is None:
         if progress:
-            _say(f"[base] fitting {model.name} with emcee ({len(data)} geometries) ...")
-        base = invert(base_post, seed=seed, max_steps=max_steps, progress=False, centre=_vector(base_optimum, base_post),
-                      tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
+            _say(f"[base] fitting {model.name} ({len(data)} geometries) ...")
+        base = fit_for_elpd(base_post, _vector(base_optimum, base_post), seed, max_steps, posterior_method)
     base_loo = base.loo["pointwise"]
     base_fit = median_fit(base.posterior, base.result.flat_samples())
     clock["base"] = time.perf_counter()
@@ -114,11 +116,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:
-            _say(f"[confirm {i}/{len(to_confirm)}] {c['change']}: emcee posterior and PSIS-LOO "
+            _say(f"[confirm {i}/{len(to_confirm)}] {c['change']}: posterior and PSIS-LOO "
                  f"({time.perf_counter() - clock['start']:.0f} s)")
         # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
-        inv = invert(c["posterior"], seed=seed, max_steps=max_steps, progress=False, centre=c["optimum"],
-                     tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
+        inv = fit_for_elpd(c["posterior"], c["optimum"], seed, max_steps, posterior_method)
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
@@ -179,6 +180,24 @@ ELPD_TAU_MULTIPLE = 20.0
 # PSIS-LOO of a candidate from at most this many draws (Vehtari et al. recommend >= 2,000 for a stable k-hat); a
 # 278-geometry full-Mueller fit kept ~9,000, and its log-likelihood, replicates and LOO took 22 s of each refit
 ELPD_DRAWS = 2000
+
+
+POSTERIOR_METHODS = ("laplace", "emcee")
+
+
+def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
+    """The Inversion whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
+    Laplace approximation corrected by importance sampling (``inversion.invert_laplace``), where its Pareto k
+    trusts it, else emcee; "emcee": emcee always. On PTFE (278 geometries, ``paper+lambertian``) the two agree:
+    posterior SDs within 3 %, ELPD-LOO within 2.1 +- 1.7, in 5 s instead of 30 (``benchmarks/laplace_vs_emcee.py``)."""
+    if posterior_method not in POSTERIOR_METHODS:
+        raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
+    if posterior_method == "laplace":
+        inv = invert_laplace(posterior, centre, seed=seed, draws=ELPD_DRAWS)
+        if inv is not None:
+            return inv
+    return invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
+                  tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
 
 
 def _say(text: str) -> None:

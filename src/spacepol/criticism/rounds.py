@@ -35,21 +35,24 @@ def as_rungs(result: dict) -> list[dict]:
                       "delta_elpd_se": step["delta_elpd_se"], "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"], "inferred_noise": step["inferred_noise"],
                       "noise": step.get("noise", {}), "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
+                      "pareto_k": inv.summary["diagnostics"].get("pareto_k"),
                       "at_bound": step["at_bound"], "_inversion": inv})
     return rungs
 
 
 def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, seed: int = 0, observables=None,
-                    candidates=None, top: int = 3, progress: bool = True, priors: dict | None = None, base=None) -> dict:
+                    candidates=None, top: int = 3, progress: bool = True, priors: dict | None = None, base=None,
+                    posterior_method: str = "laplace") -> dict:
     """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
-    ``conclusion`` over the whole path; ``_reports`` keeps each round's full report."""
+    ``conclusion`` over the whole path; ``_reports`` keeps each round's full report. ``posterior_method``: how
+    each fit's posterior is drawn (``diagnose.fit_for_elpd``)."""
     reports, current = [], model
     path = []
     for r in range(rounds):
         if progress:
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
-                          progress=progress, priors=priors, base=base, simplifications=2)
+                          progress=progress, priors=priors, base=base, simplifications=2, posterior_method=posterior_method)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))
@@ -58,7 +61,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
             simplification = _simplification(report)
             if simplification is None:
                 path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
-                                                           priors, report["_base"])
+                                                           priors, report["_base"], posterior_method)
                 break
         lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -86,7 +89,8 @@ def _simplification(report: dict):
     return min(simpler, key=lambda c: (c["posterior"].ndim, -c["delta_elpd"])) if simpler else None
 
 
-def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base) -> list[dict]:
+def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
+                      posterior_method: str = "laplace") -> list[dict]:
     """Where the path stopped: refit every other member of each of the final model's slots (and the slot
     emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
     the conclusion can say which parts of the final model the data pin down."""
@@ -101,7 +105,8 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     # the user's prior overrides that concern these models (the others belong to effects not weighed here)
     known = set(base.posterior.names) | {p.name for c in changes(model, data, names) for p in c.model.parameters}
     report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=False,
-                      priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels)
+                      priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
+                      posterior_method=posterior_method)
     return _equivalent(report, labels)
 
 

@@ -9,15 +9,22 @@ from ..io.atomic import atomic_path, save_figure, write_json
 from .criticism_figures import ladder_figure
 
 
+def _posterior_check(rung: dict) -> str:
+    """R-hat of an emcee fit, or the importance weights' Pareto k of a Laplace fit (``inversion.invert_laplace``)."""
+    if rung.get("rhat_max") is None and rung.get("pareto_k") is not None:
+        return f"Laplace-IS, Pareto k {rung['pareto_k']:.2f}"
+    return f"R-hat {rung['rhat_max']:.3f}"
+
+
 def ladder_table(public: list[dict]) -> list[str]:
     noise = list(dict.fromkeys(k for r in public for k in r.get("inferred_noise", {})))
-    head = "| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO |" + "".join(f" {n} (inferred) |" for n in noise) + " R-hat max |"
+    head = "| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO |" + "".join(f" {n} (inferred) |" for n in noise) + " posterior check |"
     lines = [head, "|" + "---|" * (6 + len(noise))]
     for i, r in enumerate(public):
         rmse = "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}"
         cells = "".join(f" {r['inferred_noise'].get(n, float('nan')):.4g} |" for n in noise)
         lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} |"
-                     f"{cells} {r['rhat_max']:.3f} |")
+                     f"{cells} {_posterior_check(r)} |")
     flags = [f"rung {i}: {bound_finding(f)}" for i, r in enumerate(public) for f in r.get("at_bound", [])]
     if flags:
         lines.append("")

@@ -75,3 +75,28 @@ def test_the_profiled_search_ends_on_the_full_posterior_at_least_as_high_as_its_
     assert polish_posterior(post, theta)[0] == pytest.approx(value, abs=1e-3)  # a local maximum already
     names = dict(zip(post.priors.names, theta))
     assert names["n"] == pytest.approx(1.5, abs=0.1) and 0.005 < names["sigma_dop"] < 0.02
+
+
+@pytest.mark.parametrize("profile", [False, True])
+def test_a_branch_is_the_posterior_with_its_parameters_held_and_compiles_nothing_new(profile):
+    """An effect's branch (k = 0 of ``specular``) equals the posterior built with k fixed by its prior, evaluated
+    through the parent's compiled program (held values as columns, not as compiled-in constants)."""
+    from spacepol.infer.optimum import _branches
+    from spacepol.infer.posterior import PinnedPosterior
+
+    data, model = _dataset()
+    post = Posterior.build(data, model, noise_floor=False)
+    parent = ProfiledPosterior.of(post) if profile else post
+    (pinned, branch), = list(_branches(parent))
+    assert pinned == {"k": 0.0} and isinstance(branch, PinnedPosterior) and "k" not in branch.priors.names
+    theta = branch.priors.sample(np.random.default_rng(2), 16)
+    parent.log_prob(branch.expand(theta))  # the parent's program, compiled
+    programs = set(post.likelihood._jitted)
+    value = branch.log_prob(theta)
+    assert set(post.likelihood._jitted) == programs
+    fixed = type(parent)(parent.likelihood, branch.priors, parent.levels, parent.full) if profile else \
+        Posterior(parent.likelihood, branch.priors)  # k compiled in as a constant: the reference
+    np.testing.assert_allclose(value, fixed.log_prob(theta), rtol=1e-12)
+    moved = branch.expand(theta)
+    moved[:, parent.priors.names.index("k")] = 0.3  # negative control: another k is another posterior
+    assert np.all(np.abs(parent.log_prob(moved) - value) > 1e-6)

@@ -188,8 +188,9 @@ POSTERIOR_METHODS = ("laplace", "emcee")
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
     """The Inversion whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
     Laplace approximation corrected by importance sampling (``inversion.invert_laplace``), where its Pareto k
-    trusts it, else emcee; "emcee": emcee always. On PTFE (278 geometries, ``paper+lambertian``) the two agree:
-    posterior SDs within 3 %, ELPD-LOO within 2.1 +- 1.7, in 5 s instead of 30 (``benchmarks/laplace_vs_emcee.py``)."""
+    trusts it, else emcee; "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``, ``paper+lambertian``)
+    the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
+    (``benchmarks/laplace_vs_emcee.py``)."""
     if posterior_method not in POSTERIOR_METHODS:
         raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
     if posterior_method == "laplace":

@@ -9,7 +9,9 @@ around its mode. So:
 2. the Hessian there by central differences of the batched log posterior (steps of half a posterior SD,
    from a first pass on the diagonal);
 3. draws from a multivariate Student-t (5 degrees of freedom: tails heavier than the Gaussian's, so the
-   importance ratios stay bounded where the posterior is skewed) with that mode and covariance;
+   importance ratios stay bounded where the posterior is skewed) with that mode and covariance. On PTFE's
+   ``paper`` posterior (rho_d and a noise level piled at bounds) three seeds gave Pareto k 0.43-0.61 with 5
+   degrees of freedom, 0.66-0.78 with 7, 0.54-0.74 with 15;
 4. importance weights log p(z | y) - log q(z), Pareto-smoothed (PSIS, Vehtari et al., JMLR 25(72), 2024). Their
    Pareto k says whether the approximation can be trusted at all (Yao et al., "Yes, but did it work?",
    ICML 2018): accepted only where k <= 0.7 and the weights' effective sample size is at least 400 (emcee's

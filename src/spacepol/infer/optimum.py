@@ -30,7 +30,7 @@ from . import local_search
 from .differentiable import cube_objective
 from .engines.de import run_de
 from .objective import NegativeLogPosterior
-from .posterior import Posterior
+from .posterior import PinnedPosterior, Posterior
 from .priors import Fixed
 from .profiled import ProfiledPosterior
 
@@ -48,7 +48,7 @@ def _branches(posterior: Posterior):
             overrides = {name: prior for name, prior in priors.priors.items() if name not in pinned}
             overrides.update({n: Fixed(float(v)) for n, v in pinned.items()})
             sub = type(priors)(priors.parameters, overrides, where=f"{effect.name} branch {pinned}")
-            yield pinned, posterior.with_priors(sub)
+            yield pinned, PinnedPosterior(posterior, sub, pinned)
 
 
 def find_optimum(posterior: Posterior, rng: np.random.Generator, evaluations: int = 4000, seeds=None,

@@ -40,10 +40,6 @@ class ProfiledPosterior(Posterior):
         sub = type(priors)(kept, {p.name: priors.priors[p.name] for p in kept}, where="profiled noise")
         return cls(posterior.likelihood, sub, tuple((n, *map(float, priors.priors[n].bounds)) for n in names), posterior)
 
-    def with_priors(self, priors) -> "ProfiledPosterior":
-        """The same profiled posterior under other priors for the parameters kept (an effect's branch)."""
-        return ProfiledPosterior(self.likelihood, priors, self.levels, self.full)
-
     def summed_log_likelihood(self, theta) -> np.ndarray:
         """The log-likelihood of each row of theta (W, D) at its profiled noise levels."""
         return self.likelihood.profiled(self.priors.to_params(theta), self.levels)[0]

@@ -20,7 +20,7 @@ import numpy as np
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--models", nargs="+", default=["paper", "paper+lambertian", "paper+polarized_diffuse", "paper+volume"])
+    ap.add_argument("--models", nargs="+", default=["paper", "paper+lambertian", "paper+polarized_diffuse"])
     ap.add_argument("--wavelength", type=float, default=0.633)
     ap.add_argument("--size", type=int, default=260)
     ap.add_argument("--seed", type=int, default=0)

@@ -74,3 +74,14 @@ def test_the_ladder_table_shows_the_inferred_noise_when_the_file_gives_none():
     assert "by construction" in text
     known = [{k: v for k, v in r.items() if k != "inferred_noise"} for r in rungs]  # control: known noise
     assert "inferred" not in "\n".join(ladder_table(known))
+
+
+def test_the_ladder_table_names_each_rungs_posterior_check():
+    """A rung fitted by emcee shows its R-hat; one diagnose fitted by Laplace + PSIS (no R-hat) its Pareto k."""
+    from spacepol.report.ladder_report import ladder_table
+
+    base = {"rmse_dop": 0.01, "chi2_red": 1.0, "elpd_loo_se": 1.0, "inferred_noise": {}}
+    rungs = [{**base, "model": "paper", "elpd_loo": 384.4, "rhat_max": 1.004},
+             {**base, "model": "paper+ggx", "elpd_loo": 400.0, "rhat_max": None, "pareto_k": 0.31}]
+    text = "\n".join(ladder_table(rungs))
+    assert "R-hat 1.004" in text and "Laplace-IS, Pareto k 0.31" in text

@@ -41,7 +41,8 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                       "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
                       "inferred_noise": noise, "noise_known": not noise, "noise": inv.summary.get("noise", {}),
-                      "rhat_max": inv.summary["diagnostics"]["rhat_max"], "parameters": inv.summary["parameters"],
+                      "rhat_max": inv.summary["diagnostics"]["rhat_max"],
+                      "pareto_k": inv.summary["diagnostics"].get("pareto_k"), "parameters": inv.summary["parameters"],
                       "at_bound": inv.summary["identifiability"].get("at_bound", []),
                       "residual_structure": inv.summary["residual_structure"]["findings"],
                       "_inversion": inv})

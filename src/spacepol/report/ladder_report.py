@@ -11,9 +11,11 @@ from .criticism_figures import ladder_figure
 
 def _posterior_check(rung: dict) -> str:
     """R-hat of an emcee fit, or the importance weights' Pareto k of a Laplace fit (``inversion.invert_laplace``)."""
-    if rung.get("rhat_max") is None and rung.get("pareto_k") is not None:
+    if rung.get("rhat_max") is not None:
+        return f"R-hat {rung['rhat_max']:.3f}"
+    if rung.get("pareto_k") is not None:
         return f"Laplace-IS, Pareto k {rung['pareto_k']:.2f}"
-    return f"R-hat {rung['rhat_max']:.3f}"
+    return "n/a"
 
 
 def ladder_table(public: list[dict]) -> list[str]:

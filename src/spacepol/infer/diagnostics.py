@@ -45,11 +45,19 @@ def loo(idata) -> dict:
         ll = idata.log_likelihood["y"].values.reshape(-1, pointwise.size)
         pointwise[failed] = logsumexp(ll[:, failed], axis=0) - np.log(ll.shape[0])
         k[failed] = np.inf
-    labels = list(idata.log_likelihood["obs_id"].values)
-    bad = [labels[i] for i in np.flatnonzero(k > 0.7)]
-    n = pointwise.size
+    return loo_fields(pointwise, k, float(res.p_loo), idata.log_likelihood["obs_id"].values)
+
+
+PARETO_K_LIMIT = 0.7  # above it an importance-sampling estimate is unreliable (Vehtari et al., JMLR 25(72), 2024)
+
+
+def loo_fields(pointwise: np.ndarray, pareto_k: np.ndarray, p_loo: float, labels) -> dict:
+    """PSIS-LOO's record from its pointwise values: ELPD-LOO, its standard error, p_loo, the Pareto k per
+    observation and the labels of those above ``PARETO_K_LIMIT``."""
+    labels, n = list(labels), pointwise.size
     return {"elpd_loo": float(pointwise.sum()), "elpd_loo_se": float(np.sqrt(n * np.var(pointwise))),
-            "p_loo": float(res.p_loo), "pareto_k": k, "pareto_k_bad": bad, "pointwise": pointwise}
+            "p_loo": float(p_loo), "pareto_k": pareto_k,
+            "pareto_k_bad": [labels[i] for i in np.flatnonzero(pareto_k > PARETO_K_LIMIT)], "pointwise": pointwise}
 
 
 def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:

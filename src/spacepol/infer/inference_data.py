@@ -21,7 +21,7 @@ _MIN_POINTWISE_DRAWS = 800
 _MEDIAN_DRAWS = 1000
 
 
-def _batched(fn, flat, batch: int):
+def batched(fn, flat, batch: int):
     """fn over blocks of ``batch`` rows (the compiled programs pad a remainder to a size they were compiled for)."""
     return np.concatenate([fn(flat[i : i + batch]) for i in range(0, len(flat), batch)], axis=0)
 
@@ -34,7 +34,7 @@ def predictive_means(posterior: Posterior, flat_theta) -> dict[str, np.ndarray]:
         pred = lik.predict(posterior.model_params(block))
         return np.stack([pred[o] for o in lik.observables], axis=0).transpose(1, 0, 2)
 
-    stacked = _batched(one, flat_theta, lik.batch_sets)  # (S, n_observables, N)
+    stacked = batched(one, flat_theta, lik.batch_sets)  # (S, n_observables, N)
     return {o: stacked[:, i, :] for i, o in enumerate(lik.observables)}
 
 
@@ -88,7 +88,7 @@ def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Gener
         step = max(step, int(np.ceil(draws * chains / max_pointwise_draws)))
     kept = len(range(0, draws, step))
     flat_kept = samples[::step].transpose(1, 0, 2).reshape(-1, ndim)
-    loglik = _batched(posterior.log_prob_pointwise, flat_kept, lik.batch_sets)  # (S', M)
+    loglik = batched(posterior.log_prob_pointwise, flat_kept, lik.batch_sets)  # (S', M)
     means = predictive_means(posterior, flat_kept)
     reps = replicate(posterior, means, noise_scales(posterior, flat_kept), rng)
 

@@ -17,7 +17,7 @@ from .chain_file import chain_iterations, compact
 from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
-from .inference_data import to_inference_data
+from .inference_data import batched, to_inference_data
 from .laplace import PROPOSAL_DF, importance_loo, laplace_importance
 from .posterior import Posterior
 from .result import Result
@@ -130,8 +130,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
                     log_prob=sample.log_prob[kept][:, None], info=info)
     idata = to_inference_data(result, posterior, rng, draws)
     lik = posterior.likelihood
-    log_likelihood = np.concatenate([posterior.log_prob_pointwise(sample.theta[i : i + lik.batch_sets])
-                                     for i in range(0, draws, lik.batch_sets)])
+    log_likelihood = batched(posterior.log_prob_pointwise, sample.theta, lik.batch_sets)
     loo_result = importance_loo(log_likelihood, sample.raw_log_weights, lik.labels)
     diagnostics = {"engine": "laplace-is", "rhat_max": None, "ess_min": sample.effective_draws, "tau_max": None,
                    "acceptance": None, "pareto_k": sample.pareto_k}

@@ -15,7 +15,8 @@ around its mode. So:
 4. importance weights log p(z | y) - log q(z), Pareto-smoothed (PSIS, Vehtari et al., JMLR 25(72), 2024). Their
    Pareto k says whether the approximation can be trusted at all (Yao et al., "Yes, but did it work?",
    ICML 2018): accepted only where k <= 0.7 and the weights' effective sample size is at least 400 (emcee's
-   ESS target). Otherwise ``laplace_importance`` returns None and the caller samples with emcee.
+   ESS target; ``ImportanceSample.reliable``). Otherwise the caller samples with emcee (``inversion.invert_laplace``
+   returns None).
 
 PSIS-LOO from such draws takes the approximation into account (Magnusson et al., "Bayesian leave-one-out
 cross-validation for large data", ICML 2019; ``loo_approximate_posterior`` in the R package loo): observation
@@ -32,10 +33,10 @@ from scipy.optimize import minimize
 from scipy.special import logsumexp
 from scipy.stats import multivariate_t
 
+from .diagnostics import PARETO_K_LIMIT, loo_fields
 from .posterior import Posterior
 from .sampling_space import SamplingSpace
 
-PARETO_K_LIMIT = 0.7  # above it importance sampling is unreliable (Vehtari et al. 2024)
 MIN_EFFECTIVE_DRAWS = 400  # as emcee's ESS target
 PROPOSAL_DF = 5.0
 
@@ -93,14 +94,14 @@ def _polish_mode(log_prob_z, z0: np.ndarray) -> np.ndarray:
 def _hessian(log_prob_z, z: np.ndarray, steps: np.ndarray) -> np.ndarray:
     """The Hessian of the batched log density at z by central differences (one call of 2D^2 + 1 rows)."""
     d = z.size
+    step = np.diag(steps)  # row j: the step along axis j
     rows = [z]
     for j in range(d):
-        for sign in (1, -1):
-            rows.append(z + sign * steps[j] * np.eye(d)[j])
+        rows += [z + step[j], z - step[j]]
     pairs = [(j, k) for j in range(d) for k in range(j + 1, d)]
     for j, k in pairs:
         for sj, sk in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-            rows.append(z + sj * steps[j] * np.eye(d)[j] + sk * steps[k] * np.eye(d)[k])
+            rows.append(z + sj * step[j] + sk * step[k])
     values = log_prob_z(np.array(rows))
     centre, axis, cross = values[0], values[1 : 1 + 2 * d].reshape(d, 2), values[1 + 2 * d :].reshape(-1, 4)
     h = np.zeros((d, d))
@@ -164,8 +165,4 @@ def importance_loo(log_likelihood: np.ndarray, raw_log_weights: np.ndarray, labe
     if failed.any():  # as diagnostics.loo: the in-sample density, flagged unreliable
         pointwise[failed] = lpd[failed]
         k[failed] = np.inf
-    n = pointwise.size
-    labels = list(labels)
-    return {"elpd_loo": float(pointwise.sum()), "elpd_loo_se": float(np.sqrt(n * np.var(pointwise))),
-            "p_loo": float(lpd.sum() - pointwise.sum()), "pareto_k": k,
-            "pareto_k_bad": [labels[i] for i in np.flatnonzero(k > PARETO_K_LIMIT)], "pointwise": pointwise}
+    return loo_fields(pointwise, k, lpd.sum() - pointwise.sum(), labels)

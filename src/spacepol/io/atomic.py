@@ -69,6 +69,9 @@ def write_text(path, text: str) -> None:
 
 
 def save_figure(fig, path, dpi=120) -> None:
-    # "tight" keeps labels that reach past the axes (sky-map titles, rotated ticks) on the page.
+    """Write ``fig`` to ``path`` (format from the suffix) atomically."""
+    # "tight" keeps labels that reach past the axes (sky-map titles, rotated ticks) on the page; a figure laid out
+    # by hand (report.panels) has room for them already, and tight costs a second draw.
+    tight = None if getattr(fig, "laid_out_by_hand", False) else "tight"
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=dpi, bbox_inches="tight")
+        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=dpi, bbox_inches=tight)

@@ -7,6 +7,7 @@ from matplotlib.figure import Figure
 
 from ..infer.inference_data import standardised_residuals
 from .inversion_figures import signed_theta_r
+from .panels import panel_grid, top_title
 
 
 def signature_figure(base, candidates, fig=None) -> Figure:
@@ -19,8 +20,8 @@ def signature_figure(base, candidates, fig=None) -> Figure:
     """
     data, observables = base.posterior.likelihood.data, base.posterior.likelihood.observables
     x = signed_theta_r(data)
-    fig = fig or Figure(figsize=(3.3 * max(len(candidates), 1) + 0.8, 2.8 * len(observables)), layout="constrained")
-    axes = fig.subplots(len(observables), max(len(candidates), 1), squeeze=False, sharex=True)
+    fig, axes = panel_grid(len(observables), max(len(candidates), 1), panel_in=(3.3, 2.8), fig=fig, sharex=True,
+                           margin_in=(0.85, 0.6, 0.55, 1.3))
     for j, (name, sig) in enumerate(candidates):
         for i, o in enumerate(observables):
             ax = axes[i, j]
@@ -34,9 +35,11 @@ def signature_figure(base, candidates, fig=None) -> Figure:
                 ax.set_xlabel("theta_r (deg), + specular side")
     axes[0, 0].legend(fontsize=7)
     if candidates:
-        fig.colorbar(dots, ax=axes.ravel().tolist(), label="theta_i (deg) of the observed residuals", shrink=0.8)
-    fig.suptitle("Observed residuals of the base model (dots) and each candidate's signature (crosses): "
-                 "where they agree, the candidate explains the misfit", fontsize=9)
+        width = fig.get_size_inches()[0]
+        fig.colorbar(dots, cax=fig.add_axes((1 - 1.0 / width, 0.2, 0.15 / width, 0.6)),
+                     label="theta_i (deg) of the observed residuals")
+    top_title(fig, "Observed residuals of the base model (dots) and each candidate's signature (crosses): "
+              "where they agree, the candidate explains the misfit")
     return fig
 
 
@@ -103,8 +106,8 @@ def residual_trends_figure(structure, fig=None) -> Figure:
     """Standardised residuals against theta_i, theta_r, dphi, phase angle and the DOP level (one row per
     observable), each panel with its Spearman rank correlation; a red title marks p < 0.01."""
     variables = [v for v in ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level") if np.ptp(structure.variables[v]) > 0]
-    fig = fig or Figure(figsize=(2.6 * len(variables) + 0.5, 2.4 * len(structure.observables)), layout="constrained")
-    axes = fig.subplots(len(structure.observables), len(variables), squeeze=False, sharey="row")
+    fig, axes = panel_grid(len(structure.observables), len(variables), panel_in=(2.6, 2.4), gap_in=(0.35, 0.4),
+                           margin_in=(0.75, 0.55, 0.45, 0.2), fig=fig, sharex="col", sharey="row")
     for i, o in enumerate(structure.observables):
         z = structure.residuals[o]
         for j, var in enumerate(variables):
@@ -116,10 +119,11 @@ def residual_trends_figure(structure, fig=None) -> Figure:
             t = structure.trends[o].get(var)  # none for a constant residual
             if t is not None:
                 ax.set_title(f"rho {t['rho']:+.2f}, p {t['p']:.1g}", fontsize=7, color="C3" if t["p"] < 0.01 else "k")
-            ax.set_xlabel(var.replace("_deg", " (deg)").replace("_", " "), fontsize=8)
+            if i == len(structure.observables) - 1:
+                ax.set_xlabel(var.replace("_deg", " (deg)").replace("_", " "), fontsize=8)
             if j == 0:
                 ax.set_ylabel(f"{o} residual / noise", fontsize=8)
-    fig.suptitle("Residual trends: a physical effect shows as a trend, noise does not", fontsize=9)
+    top_title(fig, "Residual trends: a physical effect shows as a trend, noise does not")
     return fig
 
 

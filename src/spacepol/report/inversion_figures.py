@@ -7,6 +7,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..infer.inference_data import predictive_means
+from .panels import panel_grid, top_title
 
 
 def corner_figure(result, truths: dict | None = None, fig=None) -> Figure:
@@ -47,9 +48,10 @@ def _in_plane(data, idx):
 
 
 def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=None, fig=None,
-               max_panels: int = 8) -> Figure:
+               max_panels: int = 8, max_axes: int = 48) -> Figure:
     """Data with the posterior-median prediction and its 90 % band against theta_r: one row per
-    fitted observable, one column per incidence angle (at most ``max_panels``, evenly chosen).
+    fitted observable, one column per incidence angle (at most ``max_panels``, evenly chosen, and fewer
+    where the rows times the columns would pass ``max_axes``: a full Mueller matrix keeps 3-4 angles).
     In-plane sweeps are drawn as curves; out-of-plane points (other azimuths at the same theta_r)
     as separate bars, since joining them in theta_r order would draw a sawtooth."""
     lik = posterior.likelihood
@@ -61,11 +63,10 @@ def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=N
         flat = flat[rng.choice(len(flat), max_draws, replace=False)]
     means = predictive_means(posterior, flat)
     panels = _panels(data)
-    if len(panels) > max_panels:
-        panels = [panels[i] for i in np.unique(np.linspace(0, len(panels) - 1, max_panels).round().astype(int))]
-    cols = len(panels)
-    fig = fig or Figure(figsize=(3.2 * cols + 0.5, 2.8 * len(observables)), layout="constrained")
-    axes = fig.subplots(len(observables), cols, squeeze=False)
+    keep = min(max_panels, max(3, max_axes // len(observables)))
+    if len(panels) > keep:
+        panels = [panels[i] for i in np.unique(np.linspace(0, len(panels) - 1, keep).round().astype(int))]
+    fig, axes = panel_grid(len(observables), len(panels), fig=fig, sharex="col", margin_in=(0.75, 0.6, 0.7, 0.2))
     for row, observable in enumerate(observables):
         lo, med, hi = np.percentile(means[observable], [5, 50, 95], axis=0)
         y = observed[observable]
@@ -94,8 +95,7 @@ def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=N
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=6)
-    fig.suptitle("Measured data (black) against the model: posterior median and 90 % band of the noise-free prediction",
-                 fontsize=9)
+    top_title(fig, "Measured data (black) against the model: posterior median and 90 % band of the noise-free prediction")
     return fig
 
 
@@ -106,8 +106,9 @@ def residual_figure(posterior, result, fig=None) -> Figure:
     data = posterior.likelihood.data
     residuals = standardised_residuals(posterior, result.flat_samples())
     observables = posterior.likelihood.observables
-    fig = fig or Figure(figsize=(7.0, 2.8 * len(observables)), layout="constrained")
-    axes = fig.subplots(len(observables), 1, squeeze=False).ravel()
+    fig, axes = panel_grid(len(observables), 1, panel_in=(7.0, 2.4 if len(observables) > 4 else 2.8), fig=fig, sharex=True,
+                           margin_in=(0.75, 0.6, 0.45, 0.2))
+    axes = axes.ravel()
     for ax, o in zip(axes, observables):
         z = residuals[o]
         for i, (ti, idx) in enumerate(_panels(data)):
@@ -116,8 +117,8 @@ def residual_figure(posterior, result, fig=None) -> Figure:
         for level in (-2, 2):
             ax.axhline(level, color="k", lw=0.5, ls=":")
         ax.set_ylabel(f"{o} residual / noise")
-        ax.set_xlabel("theta_r (deg; < 0: source side)")
         ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("theta_r (deg; < 0: source side)")
     axes[0].legend(fontsize=7, ncol=4)
     axes[0].set_title("Standardised residuals (data - posterior-median prediction) / noise; noise alone stays within +-2",
                       fontsize=9)
@@ -134,8 +135,8 @@ def mueller_residual_figure(posterior, result, fig=None) -> Figure:
     lik = posterior.likelihood
     data, residuals = lik.data, standardised_residuals(posterior, result.flat_samples())
     x = signed_theta_r(data)
-    fig = fig or Figure(figsize=(11.0, 9.0), layout="constrained")
-    axes = fig.subplots(4, 4, sharex=True)
+    fig, axes = panel_grid(4, 4, panel_in=(2.7, 2.1), gap_in=(0.45, 0.45), margin_in=(0.5, 0.55, 0.45, 1.2),
+                           fig=fig, sharex=True)
     dots = None
     for i in range(4):
         for j in range(4):
@@ -155,7 +156,7 @@ def mueller_residual_figure(posterior, result, fig=None) -> Figure:
     for ax in axes[-1]:
         ax.set_xlabel("theta_r (deg; < 0: source side)", fontsize=7)
     if dots is not None:
-        fig.colorbar(dots, ax=axes.ravel().tolist(), label="theta_i (deg)", shrink=0.6)
-    fig.suptitle("Standardised residuals per Mueller element (noise alone: RMS ~ 1, within +-2; red title: RMS > 1.5)",
-                 fontsize=9)
+        fig.colorbar(dots, cax=fig.add_axes((1 - 0.95 / fig.get_size_inches()[0], 0.25, 0.15 / fig.get_size_inches()[0], 0.5)),
+                     label="theta_i (deg)")
+    top_title(fig, "Standardised residuals per Mueller element (noise alone: RMS ~ 1, within +-2; red title: RMS > 1.5)")
     return fig

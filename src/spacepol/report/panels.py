@@ -1,0 +1,45 @@
+"""Grids of panels with a fixed layout.
+
+Constrained layout measures every tick label of every panel on every draw: on the tens of panels of a
+full-Mueller fit it cost three times the drawing itself (fit.png: 17 s of a 60 s PTFE report). A grid of
+like panels needs no solver: margins and gaps in inches leave room for the labels.
+"""
+
+from __future__ import annotations
+
+from matplotlib.figure import Figure
+
+
+class HandLaidFigure(Figure):
+    """A Figure whose panels were placed by `panel_grid`: `io.atomic.save_figure` draws it once, without the
+    tight-bbox pass (any layout engine, even a placeholder, makes matplotlib draw twice)."""
+
+    laid_out_by_hand = True
+
+
+def panel_grid(rows: int, cols: int, *, panel_in: tuple[float, float] = (3.2, 2.8),
+               gap_in: tuple[float, float] = (0.7, 0.6), margin_in: tuple[float, float, float, float] = (0.75, 0.6, 0.55, 0.2),
+               fig: Figure | None = None, **subplots_kw):
+    """A ``rows`` x ``cols`` grid of panels, each ``panel_in`` (width, height) inches including its share of the
+    gaps; ``gap_in`` (horizontal, vertical) leaves room for each panel's tick labels, y label and title,
+    ``margin_in`` (left, bottom, top, right) for the outer labels and the title (`top_title`). Returns
+    (figure, 2-D axes array); ``subplots_kw`` go to ``Figure.subplots`` (sharex, sharey)."""
+    left, bottom, top, right = margin_in
+    width = cols * panel_in[0] + left + right - gap_in[0]
+    height = rows * panel_in[1] + bottom + top - gap_in[1]
+    if fig is None:
+        fig = HandLaidFigure(figsize=(width, height))
+    else:
+        width, height = fig.get_size_inches()
+    axis_w = max((width - left - right - (cols - 1) * gap_in[0]) / cols, 0.1)
+    axis_h = max((height - bottom - top - (rows - 1) * gap_in[1]) / rows, 0.1)
+    axes = fig.subplots(rows, cols, squeeze=False, gridspec_kw=dict(
+        left=left / width, right=1 - right / width, bottom=bottom / height, top=1 - top / height,
+        wspace=gap_in[0] / axis_w, hspace=gap_in[1] / axis_h), **subplots_kw)
+    return fig, axes
+
+
+def top_title(fig: Figure, text: str, fontsize: float = 9) -> None:
+    """The figure's title 0.1 in below its top edge (suptitle's default, a fraction of the height, falls into
+    the top panels of a tall figure)."""
+    fig.suptitle(text, fontsize=fontsize, y=1 - 0.1 / fig.get_size_inches()[1], va="top")

@@ -30,8 +30,36 @@ def near_gaussian():
 
 
 def test_laplace_is_agrees_with_emcee_where_the_posterior_is_near_gaussian(near_gaussian):
-    post, _, approx, exact = near_gaussian
-    assert approx is not None, "the approximation was refused on a near-Gaussian posterior"
+    _assert_agreement(*near_gaussian)
+
+
+@pytest.fixture(scope="module")
+def at_bound():
+    """The validation suite's null set (k = 0 at its bound) under paper + extinction: (posterior, optimum, the
+    adapted declared-parameter approximation, emcee)."""
+    from spacepol.criticism.hidden_effects import measurement, suite
+
+    data = measurement([c for c in suite() if c.effect is None][0])
+    post = Posterior.build(data, Model.from_string("paper+extinction"))
+    _, centre = find_optimum(post, np.random.default_rng(0))
+    approx = invert_laplace(post, centre, seed=1)
+    exact = invert(post, seed=1, progress=False, centre=centre)
+    return post, centre, approx, exact
+
+
+def test_a_parameter_at_its_bound_is_sampled_in_the_declared_parameters_and_agrees_with_emcee(at_bound):
+    """k piles at 0: the t at the logit-CDF mode is refused (its Pareto k > 0.7, the control), the adapted mixture in
+    the declared parameters is accepted and agrees with emcee."""
+    post, centre, approx, exact = at_bound
+    assert exact.summary["parameters"]["k"]["q05"] < 0.01  # the posterior does reach the bound
+    assert approx is not None and "declared parameters" in approx.result.info["proposal"]
+    _assert_agreement(post, centre, approx, exact)
+    in_z = laplace_importance(post, centre, np.random.default_rng(1), adapt=False)
+    assert in_z is not None and not in_z.reliable and in_z.pareto_k > 0.7, in_z.pareto_k
+
+
+def _assert_agreement(post, centre, approx, exact):
+    assert approx is not None, "the approximation was refused"
     d = approx.summary["diagnostics"]
     assert d["pareto_k"] <= 0.7 and d["ess_min"] >= 400 and d["rhat_max"] is None
     a, e = approx.result.flat_samples(), exact.result.flat_samples()

@@ -18,7 +18,7 @@ from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quanti
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
 from .inference_data import batched, to_inference_data
-from .laplace import PROPOSAL_DF, importance_loo, laplace_importance
+from .laplace import importance_loo, laplace_importance
 from .posterior import Posterior
 from .result import Result
 from .sampling_space import SamplingSpace
@@ -121,8 +121,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     centre_value = float(posterior.log_prob(centre[None, :])[0])
     best = centre if centre_value >= sample.log_prob.max() else sample.theta[int(np.argmax(sample.log_prob))]
     info = {"engine": "laplace-is", "draws": draws, "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
-            "proposal": f"multivariate t ({PROPOSAL_DF:g} degrees of freedom) at the mode in the logit-CDF space, "
-                        "Laplace covariance"}
+            "proposal": sample.proposal}
     result = Result(method="laplace-is", model=posterior.likelihood.model.name, names=names,
                     best=dict(zip(names, map(float, best))), objective=-float(max(centre_value, sample.log_prob.max())),
                     objective_name="negative_log_posterior", n_evaluations=posterior.n_evaluations,

@@ -21,7 +21,7 @@ def signature_figure(base, candidates, fig=None) -> Figure:
     data, observables = base.posterior.likelihood.data, base.posterior.likelihood.observables
     x = signed_theta_r(data)
     fig, axes = panel_grid(len(observables), max(len(candidates), 1), panel_in=(3.3, 2.8), fig=fig, sharex=True,
-                           margin_in=(0.85, 0.6, 0.55, 1.3))
+                           margin_in=(0.85, 0.6, 0.75, 1.3))
     for j, (name, sig) in enumerate(candidates):
         for i, o in enumerate(observables):
             ax = axes[i, j]

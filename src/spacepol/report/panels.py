@@ -7,6 +7,8 @@ like panels needs no solver: margins and gaps in inches leave room for the label
 
 from __future__ import annotations
 
+import textwrap
+
 from matplotlib.figure import Figure
 
 
@@ -41,5 +43,7 @@ def panel_grid(rows: int, cols: int, *, panel_in: tuple[float, float] = (3.2, 2.
 
 def top_title(fig: Figure, text: str, fontsize: float = 9) -> None:
     """The figure's title 0.1 in below its top edge (suptitle's default, a fraction of the height, falls into
-    the top panels of a tall figure)."""
-    fig.suptitle(text, fontsize=fontsize, y=1 - 0.1 / fig.get_size_inches()[1], va="top")
+    the top panels of a tall figure), wrapped to the figure's width (a narrow grid would cut a long title)."""
+    width_in, height_in = fig.get_size_inches()
+    chars_per_line = max(20, int(width_in * 72 / (0.55 * fontsize)))  # a character is ~0.55 em wide
+    fig.suptitle(textwrap.fill(text, chars_per_line), fontsize=fontsize, y=1 - 0.1 / height_in, va="top")

@@ -26,6 +26,11 @@ from .sampling_space import SamplingSpace
 
 @dataclass
 class Inversion:
+    """One inversion's whole outcome: the ``posterior`` it sampled (data, model, priors), the engine's ``result``
+    (draws, best point), the ArviZ ``idata`` (posterior, sample_stats, log_likelihood, posterior_predictive,
+    observed_data), the ``summary`` written as summary.json, the PSIS-LOO record ``loo`` and the
+    ``identifiability`` findings."""
+
     posterior: Posterior
     result: Result
     idata: object

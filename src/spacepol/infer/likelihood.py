@@ -81,6 +81,11 @@ def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]
 
 
 class Likelihood:
+    """The log likelihood of a model's predictions for the observables fitted from a data set: one Gaussian (or
+    Student-t, ``robust``) term per measured number, with the file's errors or an inferred noise level per channel
+    group (the nuisance parameters, ``nuisance``). Observables whose numbers a fitted one already holds are left
+    out (``left_out``), so no measured number counts twice. Evaluated for many parameter rows at once."""
+
     def __init__(self, data: Dataset, model: Model, observables=None, robust: bool = False, nu: float = 4.0):
         self.data, self.model = data, model
         # left_out: observables in the data not fitted because a fitted one holds their numbers

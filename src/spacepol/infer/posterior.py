@@ -12,6 +12,10 @@ from .prior_set import PriorSet
 
 
 class Posterior:
+    """The log posterior over the free parameters ``names``: a ``Likelihood`` and the ``PriorSet`` of the model's
+    parameters and its noise levels. Callable on rows of parameter vectors (W, D) -> (W,); ``build`` assembles it
+    from a data set and a model, with the noise the data measure themselves as a floor of the inferred noise."""
+
     def __init__(self, likelihood: Likelihood, priors: PriorSet, prior_only: bool = False):
         self.likelihood, self.priors = likelihood, priors
         self.prior_only = prior_only  # sample the prior alone (a check of the sampler and the priors)

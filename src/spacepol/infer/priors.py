@@ -64,6 +64,8 @@ def _check_interval(lower: float, upper: float, what: str) -> None:
 
 @dataclass(frozen=True)
 class Uniform(Prior):
+    """Uniform on [lower, upper] (finite bounds)."""
+
     lower: float
     upper: float
 

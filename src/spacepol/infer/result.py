@@ -9,6 +9,10 @@ import numpy as np
 
 @dataclass
 class Result:
+    """What an engine returns: an optimizer's best point and its search history, or a sampler's draws
+    (``samples``: draws x chains x D, after burn-in and thinning) with their log posterior; ``info`` holds the
+    engine's own settings and diagnostics."""
+
     method: str
     model: str
     names: list[str]

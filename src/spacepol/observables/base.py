@@ -26,6 +26,10 @@ _LOG_2PI = math.log(2 * math.pi)
 
 
 class Observable:
+    """A measured quantity the likelihood can fit (DOP, BRDF, Stokes, AoP, the Mueller matrix): its ``channels``,
+    whether the file holds it (``present``), the observed numbers and their errors, the model's prediction of
+    it, and the nuisance noise level used when the file gives no errors. Found through the observable registry."""
+
     name: str = ""
     channels: tuple[str, ...] = ()
     label: str = ""  # axis label

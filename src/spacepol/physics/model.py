@@ -52,6 +52,10 @@ class Prediction:
 
 
 class Model:
+    """A pBRDF model: a list of effects (registered names, classes or instances) that together predict the
+    Mueller matrix, BRDF and DOP at each geometry; ``from_string("paper+polarized_diffuse")`` builds one from
+    DESIGN.md's names, ``parameters`` lists its parameters with their default priors."""
+
     def __init__(self, effects):
         self.effects: list[Effect] = [self._instance(e) for e in effects]
         self._check()

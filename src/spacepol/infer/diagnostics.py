@@ -13,6 +13,8 @@ from .result import Result
 
 
 def convergence(idata, result: Result) -> dict:
+    """R-hat (rank-normalised) and bulk and tail ESS per parameter from ArviZ, their worst values, and the engine's
+    autocorrelation time and acceptance fraction where it reports them."""
     rhat = az.rhat(idata)
     ess_bulk = az.ess(idata, method="bulk")
     ess_tail = az.ess(idata, method="tail")
@@ -30,6 +32,8 @@ def convergence(idata, result: Result) -> dict:
 
 
 def loo(idata) -> dict:
+    """PSIS-LOO of the draws in ``idata`` (its log_likelihood group, variable "y"): ``loo_fields``' record. Where
+    PSIS fails for an observation, its in-sample log predictive density stands in and its Pareto k is set to inf."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = az.loo(idata, pointwise=True, var_name="y")
@@ -76,11 +80,13 @@ def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> di
 
 
 def quantiles(result: Result) -> dict:
+    """``quantile_dict`` of every free parameter's draws, by name."""
     flat = result.flat_samples()
     return {name: quantile_dict(flat[:, j]) for j, name in enumerate(result.names)}
 
 
 def quantile_dict(values) -> dict:
+    """Median and the 5, 16, 84 and 95 % quantiles of ``values`` (summary.json's fields)."""
     q = np.percentile(values, [5, 16, 50, 84, 95])
     return {"median": float(q[2]), "q05": float(q[0]), "q16": float(q[1]), "q84": float(q[3]), "q95": float(q[4])}
 

@@ -131,11 +131,13 @@ class _Mixture:
         self.components, self.weights = list(components), np.asarray(weights, float)
 
     def rvs(self, draws: int, rng: np.random.Generator) -> np.ndarray:
+        """``draws`` rows, each component contributing a multinomial share, in random order."""
         counts = rng.multinomial(draws, self.weights)
         parts = [np.atleast_2d(c.rvs(size=m, random_state=rng)) for c, m in zip(self.components, counts) if m > 0]
         return np.concatenate(parts)[rng.permutation(draws)]
 
     def logpdf(self, x: np.ndarray) -> np.ndarray:
+        """The mixture's log density at rows ``x``."""
         return logsumexp([np.log(w) + c.logpdf(x) for c, w in zip(self.components, self.weights)], axis=0)
 
     def widened(self, component) -> "_Mixture":

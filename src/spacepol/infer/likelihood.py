@@ -141,15 +141,19 @@ class Likelihood:
 
     @property
     def n_obs(self) -> int:
+        """How many measured numbers are fitted (channels x geometries)."""
         return len(self.observables) * len(self.data)
 
     def observable_of(self, channel: str):
+        """The Observable that owns ``channel``."""
         return self._owner[channel]
 
     def observed(self) -> dict[str, np.ndarray]:
+        """The measured numbers per fitted channel."""
         return dict(self._y)
 
     def predict(self, model_params: dict) -> dict[str, np.ndarray]:
+        """The model's prediction of every fitted channel at the data's geometries (uncompiled: for reports)."""
         pred = self.model.evaluate(model_params, self.geometry, mueller=self.needs_mueller, check=False)
         out = {}
         for o in self.objects:
@@ -161,6 +165,7 @@ class Likelihood:
         return None if channel in self._errors else self._owner[channel].noise_parameter(channel).name
 
     def inferred(self, channel: str) -> bool:
+        """Whether ``channel``'s noise is a nuisance parameter (the file gives no errors for it)."""
         return channel not in self._errors
 
     def scale(self, channel: str, params: dict | None = None):
@@ -176,9 +181,11 @@ class Likelihood:
         return self._owner[channel].residual(channel, self._y[channel], mu, self.inferred(channel))
 
     def standardise(self, channel: str, mu, scale):
+        """Residuals of prediction ``mu`` in units of the noise ``scale``."""
         return self.residual(channel, mu) / scale
 
     def replicate(self, channel: str, mu, scale, rng: np.random.Generator):
+        """A replicated measurement of ``channel`` (posterior predictive): prediction ``mu`` plus noise ``scale``."""
         return self._owner[channel].replicate(channel, mu, scale, self.inferred(channel), rng)
 
     def pointwise(self, params: dict) -> np.ndarray:

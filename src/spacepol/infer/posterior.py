@@ -68,6 +68,7 @@ class Posterior:
 
     @property
     def ndim(self) -> int:
+        """The number of free parameters."""
         return self.priors.ndim
 
     def model_params(self, theta) -> dict:
@@ -76,6 +77,7 @@ class Posterior:
         return {k: v for k, v in self.priors.to_params(np.atleast_2d(theta)).items() if k in names}
 
     def log_prob_pointwise(self, theta) -> np.ndarray:
+        """The log likelihood of each fitted number for each row of theta (W, D) -> (W, numbers): what PSIS-LOO reads."""
         theta = np.atleast_2d(theta)
         return self.likelihood.pointwise(self.priors.to_params(theta))
 

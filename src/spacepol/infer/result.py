@@ -28,14 +28,17 @@ class Result:
     info: dict = field(default_factory=dict)
 
     def best_vector(self) -> np.ndarray:
+        """``best`` as a vector in ``names`` order."""
         return np.array([self.best[n] for n in self.names])
 
     def flat_samples(self) -> np.ndarray:
+        """The draws of every chain stacked: (draws x chains, D). An optimizer's result has none (ValueError)."""
         if self.samples is None:
             raise ValueError(f"{self.method} gives a point estimate, not samples")
         return self.samples.reshape(-1, self.samples.shape[-1])
 
     def to_json(self) -> dict:
+        """The result as JSON-ready fields (what ``optimize`` prints)."""
         out = {
             "method": self.method, "model": self.model, "best": self.best,
             "objective": self.objective, "objective_name": self.objective_name,

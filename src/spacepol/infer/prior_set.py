@@ -167,13 +167,16 @@ class PriorSet:
 
     @property
     def ndim(self) -> int:
+        """The number of free parameters."""
         return len(self.names)
 
     @property
     def bounds(self) -> np.ndarray:
+        """(D, 2): each free parameter's support."""
         return np.array([self.priors[n].bounds for n in self.names])
 
     def ln_prob(self, theta) -> np.ndarray:
+        """The joint log prior density of each row of theta (W, D)."""
         theta = np.atleast_2d(theta)
         if self._all_uniform:
             inside = np.all((theta >= self._lower) & (theta <= self._upper), axis=1)
@@ -184,6 +187,7 @@ class PriorSet:
         return total
 
     def rescale(self, u) -> np.ndarray:
+        """Rows of the unit cube (W, D) to parameter vectors, each through its prior's inverse CDF."""
         u = np.atleast_2d(u)
         return np.column_stack([self.priors[n].rescale(u[:, j]) for j, n in enumerate(self.names)])
 
@@ -194,6 +198,7 @@ class PriorSet:
         return np.column_stack([np.interp(theta[:, j], self.priors[n].rescale(grid), grid) for j, n in enumerate(self.names)])
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """``size`` parameter vectors drawn from the priors (size, D)."""
         return self.rescale(rng.uniform(size=(size, self.ndim)))
 
     def to_params(self, theta) -> dict[str, np.ndarray]:
@@ -204,4 +209,5 @@ class PriorSet:
         return params
 
     def describe(self) -> dict[str, str]:
+        """Every parameter's prior in words, by name (fixed ones included)."""
         return {name: str(prior) for name, prior in self.priors.items()}

@@ -24,6 +24,7 @@ class Prior:
     upper: float
 
     def ln_prob(self, x):
+        """The log density at x (numpy or JAX arrays); -inf outside [lower, upper]."""
         raise NotImplementedError
 
     def rescale(self, u):
@@ -35,14 +36,17 @@ class Prior:
         raise NotImplementedError
 
     def sample(self, rng: np.random.Generator, size=None):
+        """Draws from the prior (inverse-CDF sampling with ``rng``)."""
         return self.rescale(rng.uniform(size=size))
 
     @property
     def bounds(self) -> tuple[float, float]:
+        """(lower, upper): the support."""
         return (self.lower, self.upper)
 
     @property
     def is_fixed(self) -> bool:
+        """Whether the parameter is held at one value (``Fixed``) rather than inferred."""
         return False
 
 

@@ -74,6 +74,8 @@ def at_bounds(posterior: Posterior, flat: np.ndarray, names: list[str]) -> list[
 
 
 def bound_finding(flag: dict) -> str:
+    """One at-bound flag in words: a physical limit the data are consistent with (k = 0), or a prior bound that
+    cuts the posterior off (the model or the prior is wrong)."""
     name, b = flag["parameter"], flag["bound"]
     where = f"(median {flag['median']:.4g}, 90 % [{flag['q05']:.4g}, {flag['q95']:.4g}])"
     if flag["physical_limit"]:
@@ -85,6 +87,8 @@ def bound_finding(flag: dict) -> str:
 
 
 def identifiability(posterior: Posterior, result: Result) -> dict:
+    """What the draws can and cannot say about each parameter: those piled at a bound, strongly correlated pairs
+    and ratios that the data fix where the parameters themselves are free, with findings in words."""
     flat = result.flat_samples()
     names = result.names
     rng = np.random.default_rng(0)

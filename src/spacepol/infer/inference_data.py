@@ -63,6 +63,7 @@ def median_fit(posterior: Posterior, samples):
 
 
 def standardised_residuals(posterior: Posterior, samples) -> dict[str, np.ndarray]:
+    """(data - posterior-median prediction) / noise per fitted channel, the noise at its posterior median."""
     mu, scale = median_fit(posterior, samples)
     lik = posterior.likelihood
     return {ch: lik.standardise(ch, mu[ch], scale[ch]) for ch in lik.observables}

@@ -46,10 +46,12 @@ class ModeSearch:
 
     @property
     def best(self) -> Mode:
+        """The mode of highest log posterior."""
         return self.modes[0]
 
     @property
     def agreed(self) -> bool:
+        """Whether enough independent searches (``agreeing``, or all of them if fewer) ended in the best mode."""
         return bool(self.modes) and self.best.found_by >= min(self.agreeing, self.searches)
 
     @property
@@ -58,6 +60,7 @@ class ModeSearch:
         return [m for m in self.modes[1:] if self.best.log_posterior - m.log_posterior < CLOSE_MODES_LOG_POSTERIOR]
 
     def add(self, value: float, theta) -> None:
+        """Record one search's optimum: the same mode as one found before when within SAME_MODE_LOG_POSTERIOR."""
         self.searches += 1
         theta = np.asarray(theta, float)
         for j, mode in enumerate(self.modes):
@@ -70,6 +73,7 @@ class ModeSearch:
         self.modes.sort(key=lambda m: -m.log_posterior)
 
     def to_json(self) -> dict:
+        """Searches, agreement and every mode with how far it lies below the best (summary.json's ``modes``)."""
         best = self.best.log_posterior
         return {"searches": self.searches, "agreed": self.agreed,
                 "modes": [{"log_posterior": m.log_posterior, "below_best": best - m.log_posterior, "found_by": m.found_by,

@@ -16,6 +16,9 @@ from .prior_set import PriorSet
 
 
 class PaperObjective:
+    """The paper's objective (eq 25): the squared DOP error relative to the measured DOP's sum of squares, for the
+    GA and nlopt baselines."""
+
     name = "eq25_relative_squared_error"
 
     def __init__(self, data, model, priors: PriorSet):
@@ -34,6 +37,8 @@ class PaperObjective:
 
 
 class NegativeLogPosterior:
+    """-log posterior as an objective to minimise (a large finite number where the posterior is zero)."""
+
     name = "negative_log_posterior"
 
     def __init__(self, posterior: Posterior):

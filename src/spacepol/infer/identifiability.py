@@ -87,8 +87,9 @@ def bound_finding(flag: dict) -> str:
 
 
 def identifiability(posterior: Posterior, result: Result) -> dict:
-    """What the draws can and cannot say about each parameter: those piled at a bound, strongly correlated pairs
-    and ratios that the data fix where the parameters themselves are free, with findings in words."""
+    """What the draws can and cannot say about each parameter: those piled at a bound, those barely narrower than
+    their prior (posterior / prior 90 % width), strongly correlated pairs, and (DOP without BRDF) intensity
+    weights of which only the ratio is measured; with findings in words."""
     flat = result.flat_samples()
     names = result.names
     rng = np.random.default_rng(0)

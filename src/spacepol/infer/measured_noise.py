@@ -39,6 +39,7 @@ class MeasuredNoise:
 
     @property
     def standard_error(self) -> float:
+        """The estimate's standard error (a median absolute deviation's, from ``n_differences`` differences)."""
         return _MAD_RELATIVE_SE * self.value / np.sqrt(self.n_differences)
 
     @property
@@ -47,6 +48,7 @@ class MeasuredNoise:
         return max(self.value - 2.0 * self.standard_error, 0.5 * self.value)
 
     def to_json(self) -> dict:
+        """The estimate, its standard error, the floor and where it came from."""
         return {"measured": self.value, "standard_error": self.standard_error, "floor": self.floor,
                 "n_differences": self.n_differences, "source": self.source}
 

@@ -79,12 +79,14 @@ class SamplingSpace:
 
     @classmethod
     def from_name(cls, priors: PriorSet, name: str) -> "SamplingSpace":
+        """The space a chain file names (``name``), so a resumed chain continues in the coordinates it began in."""
         if name == DeclaredSpace.family:
             return DeclaredSpace(priors)
         _, _, rest = name.partition(" except ")
         return cls(priors, [n for n in rest.split(",") if n])
 
     def to_z(self, theta) -> np.ndarray:
+        """Rows of declared parameters (W, D) to the sampling coordinates z (the logit of each prior's CDF)."""
         theta = np.atleast_2d(np.asarray(theta, float))
         z = theta.copy()
         for j, prior in enumerate(self._priors):
@@ -148,4 +150,5 @@ class DeclaredSpace(SamplingSpace):
 
     @property
     def name(self) -> str:
+        """The family alone: every parameter is kept in its declared coordinates."""
         return self.family

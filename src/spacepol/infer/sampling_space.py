@@ -86,7 +86,8 @@ class SamplingSpace:
         return cls(priors, [n for n in rest.split(",") if n])
 
     def to_z(self, theta) -> np.ndarray:
-        """Rows of declared parameters (W, D) to the sampling coordinates z (the logit of each prior's CDF)."""
+        """Rows of declared parameters (W, D) to the sampling coordinates z: the logit of each prior's CDF, the
+        parameters in ``declared`` as they are."""
         theta = np.atleast_2d(np.asarray(theta, float))
         z = theta.copy()
         for j, prior in enumerate(self._priors):

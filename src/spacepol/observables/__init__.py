@@ -24,6 +24,7 @@ def default_for(present: list[str]) -> tuple[list[str], dict[str, str]]:
 
 
 def get(name: str) -> Observable:
+    """The registered observable of that name (or alias); one clear error for an unknown one."""
     key = ALIASES.get(name, name)
     if key not in OBSERVABLES:
         raise ParameterError(f"unknown observable '{name}' (use {', '.join(OBSERVABLES)})")

@@ -23,6 +23,8 @@ def wrap_deg(angle):
 
 
 class AoP(ColumnObservable):
+    """The angle of linear polarization (deg, modulo 180); its inferred noise grows as 1 / DOP."""
+
     name = "aop"
     scale_free = True
     channels = ("aop",)

@@ -44,6 +44,7 @@ class Observable:
     contains: tuple[str, ...] = ()
 
     def present(self, data) -> bool:
+        """Whether the data set holds this observable."""
         raise NotImplementedError
 
     def observed(self, data) -> dict[str, np.ndarray]:

@@ -14,6 +14,9 @@ _FLOOR = 1e-300
 
 
 class BRDF(ColumnObservable):
+    """The BRDF (sr^-1): with the file's errors, Gaussian in the BRDF; inferred, a relative noise (Gaussian in
+    log BRDF)."""
+
     name = "brdf"
     channels = ("brdf",)
     label = "BRDF (sr^-1)"

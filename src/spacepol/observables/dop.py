@@ -10,6 +10,8 @@ from .base import ColumnObservable
 
 
 class DOP(ColumnObservable):
+    """The degree of polarization of the scattered light for unpolarized incidence (the paper's observable)."""
+
     name = "dop"
     scale_free = True
     channels = ("dop",)

@@ -27,6 +27,7 @@ GROUP_OF = {e: g for g, members in GROUPS.items() for e in members}
 
 
 def index(element: str) -> tuple[int, int]:
+    """Zero-based (row, column) of a Mueller element name ("m34" -> (2, 3))."""
     return int(element[1]) - 1, int(element[2]) - 1
 
 
@@ -38,6 +39,9 @@ def normalised(mueller) -> dict[str, np.ndarray]:
 
 
 class Mueller(Observable):
+    """The 15 normalised Mueller elements m_ij = M_ij / M_11, with an inferred noise per element group (polarizance
+    and diattenuation, the linear block, the circular elements) where the file gives no errors."""
+
     name = "mueller"
     scale_free = True
     channels = ELEMENTS

@@ -18,6 +18,8 @@ def _normalised(stokes, row):
 
 
 class Stokes(Observable):
+    """The normalised Stokes parameters q = S1/S0 and u = S2/S0 of the scattered light (unpolarized incidence)."""
+
     name = "stokes"
     scale_free = True
     channels = ("q", "u")

@@ -7,7 +7,7 @@ from matplotlib.figure import Figure
 
 from ..infer.inference_data import standardised_residuals
 from .inversion_figures import signed_theta_r
-from .panels import panel_grid, top_title
+from .panels import margin_colorbar, panel_grid, top_title
 
 
 def signature_figure(base, candidates, fig=None) -> Figure:
@@ -35,9 +35,7 @@ def signature_figure(base, candidates, fig=None) -> Figure:
                 ax.set_xlabel("theta_r (deg), + specular side")
     axes[0, 0].legend(fontsize=7)
     if candidates:
-        width = fig.get_size_inches()[0]
-        fig.colorbar(dots, cax=fig.add_axes((1 - 1.0 / width, 0.2, 0.15 / width, 0.6)),
-                     label="theta_i (deg) of the observed residuals")
+        margin_colorbar(fig, dots, "theta_i (deg) of the observed residuals", from_right_in=1.0, bottom=0.2, height=0.6)
     top_title(fig, "Observed residuals of the base model (dots) and each candidate's signature (crosses): "
               "where they agree, the candidate explains the misfit")
     return fig

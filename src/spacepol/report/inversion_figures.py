@@ -7,7 +7,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..infer.inference_data import predictive_means
-from .panels import panel_grid, top_title
+from .panels import margin_colorbar, panel_grid, top_title
 
 
 def corner_figure(result, truths: dict | None = None, fig=None) -> Figure:
@@ -156,7 +156,6 @@ def mueller_residual_figure(posterior, result, fig=None) -> Figure:
     for ax in axes[-1]:
         ax.set_xlabel("theta_r (deg; < 0: source side)", fontsize=7)
     if dots is not None:
-        fig.colorbar(dots, cax=fig.add_axes((1 - 0.95 / fig.get_size_inches()[0], 0.25, 0.15 / fig.get_size_inches()[0], 0.5)),
-                     label="theta_i (deg)")
+        margin_colorbar(fig, dots, "theta_i (deg)", from_right_in=0.95, bottom=0.25, height=0.5)
     top_title(fig, "Standardised residuals per Mueller element (noise alone: RMS ~ 1, within +-2; red title: RMS > 1.5)")
     return fig

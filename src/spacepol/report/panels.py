@@ -41,6 +41,14 @@ def panel_grid(rows: int, cols: int, *, panel_in: tuple[float, float] = (3.2, 2.
     return fig, axes
 
 
+def margin_colorbar(fig: Figure, mappable, label: str, from_right_in: float, bottom: float, height: float):
+    """A colorbar 0.15 in wide in the figure's right margin, its left edge ``from_right_in`` inches from the right
+    edge, spanning ``bottom`` to ``bottom + height`` of the figure's height (stealing no width from the panels)."""
+    width_in = fig.get_size_inches()[0]
+    return fig.colorbar(mappable, cax=fig.add_axes((1 - from_right_in / width_in, bottom, 0.15 / width_in, height)),
+                        label=label)
+
+
 def top_title(fig: Figure, text: str, fontsize: float = 9) -> None:
     """The figure's title 0.1 in below its top edge (suptitle's default, a fraction of the height, falls into
     the top panels of a tall figure), wrapped to the figure's width (a narrow grid would cut a long title)."""

@@ -58,7 +58,7 @@ class ImportanceSample:
     """Draws from a proposal near the posterior with their Pareto-smoothed weights.
 
     ``theta``: (S, D) draws in the declared parameters; ``log_weights``: (S,) smoothed, normalised (log sum
-    exp = 0); ``raw_log_weights``: (S,) log p(z | y) - log q(z) before smoothing (for LOO); ``log_prob``: (S,) the
+    exp = 0); ``raw_log_weights``: (S,) log p | y - log q before smoothing, in the proposal's coordinates (z or theta; for LOO); ``log_prob``: (S,) the
     log posterior in the declared parameters (as ``Posterior.log_prob``); ``pareto_k`` and ``effective_draws``
     of the weights; ``mode``: the posterior's mode in theta; ``proposal``: what the draws came from, in words."""
 
@@ -200,16 +200,15 @@ def laplace_importance(posterior: Posterior, centre, rng: np.random.Generator, d
                                        "Laplace covariance")
     if sample.reliable or not adapt:
         return sample
-    adapted = _adapted_in_theta(posterior, space, mode, covariance, rng, draws, df)
+    adapted = _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df)
     return adapted if adapted is not None and adapted.reliable else sample
 
 
-def _adapted_in_theta(posterior, space, mode, covariance, rng, draws, df) -> ImportanceSample | None:
+def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df) -> ImportanceSample | None:
     """The declared-parameter proposal (module step 4): the z-space Laplace covariance carried to theta by the
     delta method, then ``ADAPTATIONS`` moment-matching steps, each a t mixed half and half with what came before."""
     eps = 1e-6
     jacobian = (space.to_theta((mode + eps)[None, :])[0] - space.to_theta((mode - eps)[None, :])[0]) / (2 * eps)
-    theta_mode = space.to_theta(mode[None, :])[0]
     try:
         proposal = _Mixture([multivariate_t(loc=theta_mode, shape=covariance * np.outer(jacobian, jacobian), df=df)], [1.0])
     except (np.linalg.LinAlgError, ValueError):

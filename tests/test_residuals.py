@@ -23,11 +23,12 @@ def test_runs_statistic_is_standard_normal_for_noise():
     assert lag1(smooth, groups) > 0.5
 
 
-def _data(spec, truth, seed):
+def _data(spec, truth, seed, wavelength_um=None):
     rng = np.random.default_rng(seed)
     ti = np.repeat([20.0, 40.0, 60.0], 14)
     tr = np.tile(np.linspace(0, 80, 14), 3)
-    data = Dataset(ti, tr, np.where(np.arange(ti.size) % 2, 180.0, 0.0))
+    data = Dataset(ti, tr, np.where(np.arange(ti.size) % 2, 180.0, 0.0),
+                   wavelength_um=None if wavelength_um is None else np.full(ti.size, wavelength_um))
     pred = Model.from_string(spec).evaluate(truth, data.geometry)
     data.dop = pred.dop + 0.005 * rng.standard_normal(ti.size)
     data.dop_err = np.full(ti.size, 0.005)

@@ -124,21 +124,29 @@ def slot_alternatives(model: Model, data, slots, names=None) -> list[str]:
 def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
     """Where the optimiser starts the changed model: at the base model's optimum, the new effect's own
     parameters at its ``neutral`` values (where it changes nothing), its default, the prior's ends and
-    middle; a parameter that refines one of the base model's (``splits``) at that value; and for a
-    replacement the new member's intensity at the old member's (a diffuse albedo carried over)."""
+    middle; a parameter that refines one of the base model's (``splits``) at that value; for a
+    replacement the new member's intensity at the old member's (a diffuse albedo carried over); and for an
+    addition beside a member of its own slot, one more row with that member's intensity moved to the new one
+    (the two share what the old one fitted alone: from the base optimum a local search cannot reach that trade,
+    since at first every step of the new intensity adds light the old one already accounts for)."""
     effect = registry.get(change.effect)
     params = {p.name: p for p in change.model.parameters}
-    carried = {}
+    carried, emptied = {}, {}
     if change.kind == "replace":
         old = registry.get(change.replaced)
         if effect.intensity and old.intensity in base_best:
             carried[effect.intensity] = base_best[old.intensity]
+    mates = [e for e in change.model.effects if change.kind == "add" and effect.slot and e.slot == effect.slot
+             and e.name != effect.name and e.intensity in base_best]
+    if mates and effect.intensity:
+        carried[effect.intensity] = base_best[mates[0].intensity]
+        emptied[mates[0].intensity] = mates[0].neutral.get(mates[0].intensity, 0.0)
     rows = []
-    for option in range(5):
+    for option in range(6 if emptied else 5):
         row = []
         for name in posterior.priors.names:
             if name in base_best:
-                row.append(base_best[name])
+                row.append(emptied[name] if option == 5 and name in emptied else base_best[name])
                 continue
             lo, hi = posterior.priors.priors[name].bounds
             default = params[name].default if name in params else 0.5 * (lo + hi)
@@ -148,7 +156,8 @@ def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
             if refined in base_best:
                 row.append(base_best[refined])
             else:
-                row.append([effect.neutral.get(bare, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][option])
+                row.append([effect.neutral.get(bare, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default),
+                            carried.get(name, default)][option])
         rows.append(row)
     bounds = posterior.priors.bounds
     return np.clip(np.array(rows, float), bounds[:, 0], bounds[:, 1])

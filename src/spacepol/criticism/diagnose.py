@@ -4,9 +4,11 @@
    sampling where its Pareto k trusts it, else emcee; ``fit_for_elpd``).
 2. Screening: for every change of M (``criticism.changes``: each registered effect added, each
    slot member replaced by another of its slot, each removable effect removed; built-ins and
-   plug-ins alike), a quick global maximum of the log posterior of the changed model; the gain
-   over M's maximum (a likelihood-ratio statistic) ranks the candidates.
-3. Confirmation: the ``top`` candidates are refitted (as M); the change in ELPD-LOO and its
+   plug-ins alike), the maximum of the log posterior of the changed model near M's (``optimum.screen_optimum``:
+   a scan over the change's own parameters, local polishes, DE seeded with them); the gain over M's maximum (a
+   likelihood-ratio statistic) ranks the candidates.
+3. Confirmation: the ``top`` candidates get a global multistart too, and are refitted (as M) from the better of
+   the two optima; the change in ELPD-LOO and its
    standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4.
 4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
    explanation says what measurement separates them (as the effects declare it). Effects declared
@@ -27,7 +29,7 @@ from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
 from ..infer.inversion import explains, invert, invert_laplace
-from ..infer.optimum import find_optimum
+from ..infer.optimum import find_optimum, multistart, screen_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
@@ -61,6 +63,11 @@ def _screen(posterior, rng, budget, seeds=None):
     return value, dict(zip(posterior.priors.names, theta))
 
 
+def model_key(model: Model) -> tuple:
+    """What identifies a model for ``diagnose``'s ``searched``: its effects in order and its wavelengths."""
+    return model.name, tuple(getattr(model, "wavelengths", ()))
+
+
 def _vector(values: dict, posterior) -> np.ndarray:
     return np.array([values[n] for n in posterior.priors.names], float)
 
@@ -68,16 +75,22 @@ def _vector(values: dict, posterior) -> np.ndarray:
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
              priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
-             posterior_method: str = "laplace") -> dict:
+             posterior_method: str = "laplace", searched: dict | None = None) -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
     ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted); ``confirm``:
     change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
     parameters to refit besides (for diagnose --rounds, which may take one when nothing is significant);
-    ``posterior_method``: how each fit's posterior is drawn (``fit_for_elpd``)."""
+    ``posterior_method``: how each fit's posterior is drawn (``fit_for_elpd``); ``searched``: the maxima already
+    found for models on these data with these priors ({``model_key``: (max log posterior, optimum by name)}), used
+    instead of a search and filled by this call (diagnose --rounds passes one from round to round: removing the
+    effect a round added gives back the model it started from, and replacing it gives a model screened then)."""
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
+    searched = {} if searched is None else searched
     base_post = _build(data, model, observables, priors)
-    base_best, base_optimum = _screen(base_post, rng, screening_evaluations)
+    if model_key(model) not in searched:
+        searched[model_key(model)] = _screen(base_post, rng, screening_evaluations)
+    base_best, base_optimum = searched[model_key(model)]
     all_candidates = changes(model, data, candidates)
     if base is None:
         if progress:
@@ -92,7 +105,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     screened = []
     for i, change in enumerate(all_candidates, start=1):
         post = _build(data, change.model, observables, priors)
-        best, optimum = _screen(post, rng, screening_evaluations, seeds=start_points(base_optimum, change, post))
+        if model_key(change.model) not in searched:
+            new = [j for j, name in enumerate(post.priors.names) if name not in base_optimum]
+            best, theta = screen_optimum(post, rng, start_points(base_optimum, change, post), new, screening_evaluations)
+            searched[model_key(change.model)] = best, dict(zip(post.priors.names, theta))
+        best, optimum = searched[model_key(change.model)]
         gain = best - base_best
         screened.append({"effect": change.effect, "change": change.label, "_change": change, "model": change.model,
                          "posterior": post, "screening_gain": float(gain), "optimum": _vector(optimum, post)})
@@ -113,6 +130,13 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     simpler = [c for c in screened if c not in to_confirm and c["posterior"].ndim < base_post.ndim
                and c["screening_gain"] > -2 * MIN_DELTA_ELPD]
     to_confirm += simpler[:simplifications]
+    for c in to_confirm:
+        # screening searched near the base model; a refit starts from the best of that and a global multistart
+        value, theta = multistart(c["posterior"], rng)
+        if value > c["screening_gain"] + base_best:
+            c.update(screening_gain=float(value - base_best), optimum=theta)
+            searched[model_key(c["model"])] = value, dict(zip(c["posterior"].priors.names, theta))
+    clock["leaders"] = time.perf_counter()
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
         if progress:
@@ -168,6 +192,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             "conclusion": _conclusion(base, confirmed, verdict),
             "seconds": {"base_fit": clock["base"] - clock["start"], "screening": clock["screening"] - clock["base"],
                         "confirmation": clock["confirmation"] - clock["screening"],
+                        "leader_search": clock["leaders"] - clock["screening"],
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)},
             "_base": base, "_confirmed": confirmed}

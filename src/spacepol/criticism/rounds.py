@@ -48,11 +48,13 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
     each fit's posterior is drawn (``diagnose.fit_for_elpd``)."""
     reports, current = [], model
     path = []
+    searched = {}  # the maxima found for each model screened so far (diagnose's ``searched``)
     for r in range(rounds):
         if progress:
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
-                          progress=progress, priors=priors, base=base, simplifications=2, posterior_method=posterior_method)
+                          progress=progress, priors=priors, base=base, simplifications=2, posterior_method=posterior_method,
+                          searched=searched)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))

@@ -120,12 +120,12 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     sample = laplace_importance(posterior, centre, rng, draws=draws)
     if sample is None or not sample.reliable:
         return None
-    kept = sample.resample(rng)
+    kept = sample.resample(rng, draws)  # the weighted draws may be more than ``draws`` (laplace.MAX_DRAWS)
     names = list(posterior.names)
     centre = np.asarray(centre, float)
     centre_value = float(posterior.log_prob(centre[None, :])[0])
     best = centre if centre_value >= sample.log_prob.max() else sample.theta[int(np.argmax(sample.log_prob))]
-    info = {"engine": "laplace-is", "draws": draws, "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
+    info = {"engine": "laplace-is", "draws": len(sample.theta), "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
             "proposal": sample.proposal}
     result = Result(method="laplace-is", model=posterior.likelihood.model.name, names=names,
                     best=dict(zip(names, map(float, best))), objective=-float(max(centre_value, sample.log_prob.max())),

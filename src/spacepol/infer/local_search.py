@@ -31,17 +31,19 @@ def value_and_gradient(f, u: np.ndarray) -> tuple[float, np.ndarray]:
     return value, np.where(np.isfinite(grad), grad, 0.0)
 
 
-def _lbfgsb(value_and_gradient, start: np.ndarray, max_iterations: int) -> np.ndarray:
-    """L-BFGS-B on [0, 1]^D from ``start`` for a function of u returning (value, gradient): the minimum's u."""
+def _lbfgsb(value_and_gradient, start: np.ndarray, max_iterations: int, ftol: float | None = None) -> np.ndarray:
+    """L-BFGS-B on [0, 1]^D from ``start`` for a function of u returning (value, gradient): the minimum's u;
+    ``ftol``: scipy's relative change of the value at which it stops (None: scipy's 2.2e-9)."""
     start = np.clip(np.asarray(start, float), 0.0, 1.0)
+    options = {"maxiter": max_iterations} | ({"ftol": ftol} if ftol is not None else {})
     res = minimize(lambda u: value_and_gradient(np.clip(u, 0.0, 1.0)), start, jac=True, method="L-BFGS-B",
-                   bounds=[(0.0, 1.0)] * start.size, options={"maxiter": max_iterations})
+                   bounds=[(0.0, 1.0)] * start.size, options=options)
     return np.clip(res.x, 0.0, 1.0)
 
 
-def polish(f, start: np.ndarray, max_iterations: int = 15000) -> tuple[float, np.ndarray]:
-    """The local minimum of the batched ``f`` on [0, 1]^D nearest ``start``: (value, u)."""
-    u = _lbfgsb(lambda u: value_and_gradient(f, u), start, max_iterations)
+def polish(f, start: np.ndarray, max_iterations: int = 15000, ftol: float | None = None) -> tuple[float, np.ndarray]:
+    """The local minimum of the batched ``f`` on [0, 1]^D nearest ``start``: (value, u); ``ftol`` as ``_lbfgsb``."""
+    u = _lbfgsb(lambda u: value_and_gradient(f, u), start, max_iterations, ftol)
     return float(f(u[None, :])[0]), u
 
 

@@ -13,9 +13,10 @@ from ..result import History, Result
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,
            popsize: int = 15, tol: float = 1e-8, seed: int | None = None, polish: bool = True,
-           seeds=None) -> Result:
+           seeds=None, polish_ftol: float | None = None) -> Result:
     """``seeds``: parameter vectors (S, D) placed in the initial population (DE is elitist, so the
-    result is never worse than the best of them)."""
+    result is never worse than the best of them); ``polish_ftol``: the closing polish's stopping tolerance
+    (``local_search._lbfgsb``)."""
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim
     history = History()
@@ -42,6 +43,6 @@ def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evalua
     )
     best_u = np.clip(res.x, 0, 1)
     if polish:
-        _, best_u = local_search.polish(lambda rows: f(rows.T), best_u)
+        _, best_u = local_search.polish(lambda rows: f(rows.T), best_u, ftol=polish_ftol)
     return history.to_result("de", objective, model_name, time.perf_counter() - start, seed,
                              {"message": str(res.message), "iterations": int(res.nit)})

@@ -63,7 +63,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
             simplification = _simplification(report)
             if simplification is None:
                 path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
-                                                           priors, report["_base"], posterior_method)
+                                                           priors, report["_base"], posterior_method, searched)
                 break
         lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -92,7 +92,7 @@ def _simplification(report: dict):
 
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
-                      posterior_method: str = "laplace") -> list[dict]:
+                      posterior_method: str = "laplace", searched: dict | None = None) -> list[dict]:
     """Where the path stopped: refit every other member of each of the final model's slots (and the slot
     emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
     the conclusion can say which parts of the final model the data pin down."""
@@ -108,7 +108,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     known = set(base.posterior.names) | {p.name for c in changes(model, data, names) for p in c.model.parameters}
     report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=False,
                       priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
-                      posterior_method=posterior_method)
+                      posterior_method=posterior_method, searched=searched)
     return _equivalent(report, labels)
 
 

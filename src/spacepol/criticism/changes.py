@@ -136,11 +136,12 @@ def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
         old = registry.get(change.replaced)
         if effect.intensity and old.intensity in base_best:
             carried[effect.intensity] = base_best[old.intensity]
-    mates = [e for e in change.model.effects if change.kind == "add" and effect.slot and e.slot == effect.slot
-             and e.name != effect.name and e.intensity in base_best]
-    if mates and effect.intensity:
-        carried[effect.intensity] = base_best[mates[0].intensity]
-        emptied[mates[0].intensity] = mates[0].neutral.get(mates[0].intensity, 0.0)
+    if change.kind == "add" and effect.slot and effect.intensity:
+        mate = next((e for e in change.model.effects if e.slot == effect.slot and e.name != effect.name
+                     and e.intensity in base_best), None)
+        if mate is not None:
+            carried[effect.intensity] = base_best[mate.intensity]
+            emptied[mate.intensity] = mate.neutral.get(mate.intensity, 0.0)
     rows = []
     for option in range(6 if emptied else 5):
         row = []
@@ -156,8 +157,8 @@ def start_points(base_best: dict, change: Change, posterior) -> np.ndarray:
             if refined in base_best:
                 row.append(base_best[refined])
             else:
-                row.append([effect.neutral.get(bare, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default),
-                            carried.get(name, default)][option])
+                # option 5 (the slot mate emptied) carries over as option 4 does
+                row.append([effect.neutral.get(bare, lo), default, hi, 0.5 * (lo + hi), carried.get(name, default)][min(option, 4)])
         rows.append(row)
     bounds = posterior.priors.bounds
     return np.clip(np.array(rows, float), bounds[:, 0], bounds[:, 1])

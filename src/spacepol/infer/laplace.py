@@ -58,6 +58,11 @@ ADAPTATIONS = 8  # at most this many moment-matching steps of the declared-param
 MAX_DRAWS = 10000  # the last proposal, trusted (Pareto k <= 0.7) but short of 400 effective draws, is drawn from up to this many
 
 
+def _trusted(pareto_k: float, effective_draws: float) -> bool:
+    """The gate on importance weights: Pareto k <= 0.7 and at least 400 effective draws."""
+    return pareto_k <= PARETO_K_LIMIT and effective_draws >= MIN_EFFECTIVE_DRAWS
+
+
 @dataclass
 class ImportanceSample:
     """Draws from a proposal near the posterior with their Pareto-smoothed weights.
@@ -79,7 +84,7 @@ class ImportanceSample:
     @property
     def reliable(self) -> bool:
         """Whether the weighted draws stand for the posterior (k <= 0.7, effective draws >= 400)."""
-        return self.pareto_k <= PARETO_K_LIMIT and self.effective_draws >= MIN_EFFECTIVE_DRAWS
+        return _trusted(self.pareto_k, self.effective_draws)
 
     def resample(self, rng: np.random.Generator, draws: int | None = None) -> np.ndarray:
         """Indices of ``draws`` equally weighted draws (systematic resampling of the smoothed weights)."""
@@ -224,11 +229,12 @@ def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws
         weights = _smoothed(raw)
         if weights is None:
             return None
-        if weights[1] <= PARETO_K_LIMIT and weights[2] >= MIN_EFFECTIVE_DRAWS:
+        if _trusted(weights[1], weights[2]):
             break
         if step == ADAPTATIONS:
             # the last proposal, drawn from again while its weights are trusted but short of 400 effective draws
-            while weights[1] <= PARETO_K_LIMIT and weights[2] < MIN_EFFECTIVE_DRAWS and len(raw) + draws <= MAX_DRAWS:
+            while (weights is not None and weights[1] <= PARETO_K_LIMIT and weights[2] < MIN_EFFECTIVE_DRAWS
+                   and len(raw) + draws <= MAX_DRAWS):
                 more = _draw(proposal, log_density, draws, rng)
                 theta, log_p, raw = (np.concatenate([a, b]) for a, b in zip((theta, log_p, raw), more))
                 weights = _smoothed(raw)

@@ -109,7 +109,8 @@ def screen_optimum(posterior: Posterior, rng: np.random.Generator, starts, new: 
         unit = np.repeat(priors.to_unit(starts[:1]), points, axis=0)
         unit[:, new] = qmc.Sobol(len(new), rng=np.random.default_rng(rng.integers(2**63))).random(points)
         rows = np.concatenate([starts, priors.rescale(unit)])
-    values = np.concatenate([posterior.log_prob(rows[i : i + 256]) for i in range(0, len(rows), 256)])
+    batch = posterior.likelihood.batch_sets
+    values = np.concatenate([posterior.log_prob(rows[i : i + batch]) for i in range(0, len(rows), batch)])
     order = [i for i in np.argsort(-values) if np.isfinite(values[i])]
     chosen = []
     for i in order:  # distinct rows: the scan may hold the same optimum's basin many times over

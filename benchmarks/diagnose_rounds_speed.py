@@ -2,7 +2,7 @@
 
 Targets: <= 300 s at one wavelength, <= 600 s at two (median of 3, on this machine).
 
-    python benchmarks/diagnose_rounds_speed.py [--repeats 3] [--wavelengths 0.633 0.633,1.064] [--rounds 4]
+    python benchmarks/diagnose_rounds_speed.py [--repeats 3] [--wavelengths 0.633 0.633,1.064] [--rounds 4] [--progress]
 
 The set: NIST's PTFE (data/ptfe), every k-th geometry plus every row of a reciprocal pair (so the set measures its
 own noise), at 0.633 um and at 0.633 + 1.064 um: 15 normalised Mueller elements and the BRDF per geometry. From
@@ -25,7 +25,7 @@ import numpy as np
 TARGETS_S = {1: 300.0, 2: 600.0}
 
 
-def child(wavelengths: list[float], rounds: int, seed: int, size: int) -> None:
+def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress: bool = False) -> None:
     from spacepol._runtime import inline_small_calls
 
     inline_small_calls()
@@ -47,7 +47,7 @@ def child(wavelengths: list[float], rounds: int, seed: int, size: int) -> None:
 
         model = SpectralModel(model, np.unique(data.wavelength_um))
     start = time.perf_counter()
-    out = diagnose_rounds(data, model, np.random.default_rng(seed), rounds, seed=seed, progress=False)
+    out = diagnose_rounds(data, model, np.random.default_rng(seed), rounds, seed=seed, progress=progress)
     wall = time.perf_counter() - start
     print(json.dumps({"wall": wall, "rows": len(data), "numbers": 16 * len(data), "seconds": out["seconds"],
                       "path": [r["change"] or r["model"] for r in out["rounds"]], "final": out["final_model"],
@@ -61,11 +61,12 @@ def main():
     ap.add_argument("--size", type=int, default=260, help="every k-th geometry so that about this many remain")
     ap.add_argument("--wavelengths", nargs="+", default=["0.633", "0.633,1.064"])
     ap.add_argument("--warm", action="store_true", help="one JAX cache folder for all repeats")
+    ap.add_argument("--progress", action="store_true", help="each repeat's progress lines on stderr (where the time goes)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         wavelengths, seed = args.child.split(":")
-        child([float(w) for w in wavelengths.split(",")], args.rounds, int(seed), args.size)
+        child([float(w) for w in wavelengths.split(",")], args.rounds, int(seed), args.size, args.progress)
         return
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as scratch:
@@ -75,9 +76,10 @@ def main():
                 cache = os.path.join(scratch, "cache" if args.warm else f"cache-{spec}-{seed}")
                 env = {**os.environ, "SPACEPOL_CACHE_DIR": cache}
                 done = subprocess.run([sys.executable, __file__, "--child", f"{spec}:{seed}", "--rounds", str(args.rounds),
-                                       "--size", str(args.size)], env=env, capture_output=True, text=True)
+                                       "--size", str(args.size)] + ["--progress"] * args.progress, env=env,
+                                      stdout=subprocess.PIPE, stderr=None if args.progress else subprocess.PIPE, text=True)
                 if done.returncode:
-                    sys.exit(f"repeat {seed} at {spec} um failed:\n{done.stderr[-3000:]}")
+                    sys.exit(f"repeat {seed} at {spec} um failed:\n{(done.stderr or '')[-3000:]}")
                 row = json.loads(done.stdout.strip().splitlines()[-1])
                 walls.append(row["wall"])
                 s = row["seconds"]

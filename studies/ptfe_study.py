@@ -45,6 +45,7 @@ from spacepol.io import read_measurements  # noqa: E402
 from spacepol.io.atomic import save_figure, write_json, write_text  # noqa: E402
 from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
+from spacepol.observables.mueller import GROUPS as MUELLER_GROUPS  # noqa: E402
 from spacepol.physics.spectral import SpectralModel  # noqa: E402
 from spacepol.report.inversion_figures import mueller_residual_figure  # noqa: E402
 
@@ -224,9 +225,54 @@ def held_findings(final: dict, held: dict) -> list[str]:
             + f". Within 10 % either way: {', '.join(same) or 'none'} (structure that n does not touch)."]
 
 
-def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=(), held=None) -> None:
-    write_json(out / "study.json", {"meta": meta, "data_reciprocity": data_recip, "rounds": rungs, "joint": list(joint),
-                                    "held_index": held, "complete": done})
+def symmetry_findings(symmetry: dict, rungs: list[dict]) -> list[str]:
+    """What the measurement's own symmetries say (``reciprocity.symmetry_checks``, no model): the noise its mirror
+    pairs show, and the part of it at theta_i = theta_r that no reciprocal, isotropic model in DESIGN's basis can fit."""
+    out = []
+    mirror = symmetry.get("mirror")
+    if mirror:
+        elements = mirror["elements"]
+        groups = {g: float(np.sqrt(np.mean([elements[e]["noise_from_mirror"] ** 2 for e in members])))
+                  for g, members in MUELLER_GROUPS.items()}
+        measured = {k.removeprefix("sigma_m_"): v["measured"] for k, v in rungs[-1].get("noise", {}).items()}
+        odd = [e for e in elements if elements[e]["rms_unmirrored"] > 1.3 * elements[e]["rms_mirrored"]]
+        out.append(f"Mirror symmetry, no model ({mirror['n_pairs']} pairs measured at dphi and -dphi): the "
+                   f"elements odd in dphi ({', '.join(odd)}) differ by "
+                   + ", ".join(f"{e} {elements[e]['rms_mirrored']:.3f}" for e in odd)
+                   + " RMS once mirrored (unmirrored: " + ", ".join(f"{elements[e]['rms_unmirrored']:.3f}" for e in odd)
+                   + "): the sample is isotropic to about the noise. The noise these pairs bound, per group: "
+                   + ", ".join(f"{g} {v:.4f}" + (f" (reciprocal pairs: {measured[g]:.4f})" if g in measured else "")
+                               for g, v in groups.items())
+                   + ": an upper bound (a slight anisotropy adds to it); where it exceeds the reciprocal pairs' figure, the "
+                   "misfit ratios above are at most that much too high.")
+    equal = symmetry.get("equal_angles")
+    if equal:
+        broken = {k: v for k, v in equal["pairs"].items() if v["rms_breaking"] > 1.5 * v["rms_opposite_sign"]}
+        kept = {k: v for k, v in equal["pairs"].items() if 1.5 * v["rms_breaking"] < v["rms_opposite_sign"]}
+        unclear = {k: v for k, v in equal["pairs"].items() if k not in broken and k not in kept}
+        if broken:
+            out.append(f"At theta_i = theta_r out of the plane ({equal['n_rows']} rows), reciprocity and mirror symmetry "
+                       "together require m31 = m13, m32 = m23, m41 = -m14, m42 = -m24, m43 = -m34 and m21 = m12 in DESIGN's "
+                       "basis (SCATMECH's: every reciprocal effect of the library obeys it to rounding). The data break "
+                       + ", ".join(f"{k} (the breaking part {v['rms_breaking']:.4f} RMS, the opposite relation's "
+                                   f"{v['rms_opposite_sign']:.4f})" for k, v in broken.items())
+                       + "; they keep " + (", ".join(f"{k} ({v['rms_breaking']:.4f} vs {v['rms_opposite_sign']:.4f})"
+                                                     for k, v in kept.items()) or "none")
+                       + ("; within a factor 1.5 either way: " + ", ".join(
+                           f"{k} ({v['rms_breaking']:.4f} vs {v['rms_opposite_sign']:.4f})" for k, v in unclear.items())
+                          if unclear else "")
+                       + ". No reciprocal, isotropic model in this basis can fit the breaking part: it is an anisotropy "
+                       "of the sample (Germer & Patrick, Proc. SPIE 8160, 81600D (2011), saw one in sintered PTFE) or a "
+                       "difference of basis on the instrument's out-of-plane rows, and it stays in the residuals of every "
+                       "model here.")
+    return out
+
+
+def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=(), held=None,
+                 symmetry: dict | None = None) -> None:
+    symmetry = symmetry or {}
+    write_json(out / "study.json", {"meta": meta, "data_reciprocity": data_recip, "data_symmetry": symmetry, "rounds": rungs,
+                                    "joint": list(joint), "held_index": held, "complete": done})
     save_figure(rounds_figure(rungs), out / "rounds.png")
     save_figure(index_figure(list(joint) or rungs), out / "n_lambda.png")
     save_figure(structure_figure(rungs), out / "residual_structure.png")
@@ -240,6 +286,7 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
              [f"- Jointly over {meta['joint_wavelengths']} um ({joint[-1]['model']}): "
               + " ".join(f for f in findings(joint, data_recip) if f.startswith(("n < 1", "The final model's n")))]
              if joint else []) + ([f"- {f}" for f in held_findings(rungs[-1], held)] if held else []) + [
+             f"- {f}" for f in symmetry_findings(symmetry, rungs)] + [
              "", "## Rounds", "",
              "| round | change | delta ELPD | ELPD-LOO | inferred noise | n(lambda) median | at bound | reciprocity (BRDF median, elements p95) |",
              "|---|---|---|---|---|---|---|---|"]
@@ -295,14 +342,15 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     if args.render_only:
         saved = json.loads((out / "study.json").read_text())
-        data_recip = reciprocity.data_violation(load("all", args.in_plane))
-        write_report(out, saved["meta"], saved["rounds"], data_recip, saved["complete"], saved.get("joint", ()),
-                     saved.get("held_index"))
+        studied = load(saved["meta"]["wavelengths"].replace(" ", ""), args.in_plane)
+        write_report(out, saved["meta"], saved["rounds"], reciprocity.data_violation(load("all", args.in_plane)),
+                     saved["complete"], saved.get("joint", ()), saved.get("held_index"), reciprocity.symmetry_checks(studied))
         return 0
     start = time.perf_counter()
     data = load(args.wavelength_um, args.in_plane)
     current = model_for(data, args.model)
     data_recip = reciprocity.data_violation(load("all", args.in_plane))  # the measurement's own check: every wavelength
+    symmetry = reciprocity.symmetry_checks(data)  # at the wavelengths studied, as the measured noise is
     print(f"{len(data)} geometries at {sorted(set(np.round(data.wavelength_um, 3)))} um; data reciprocity {data_recip}", file=sys.stderr)
     rng = np.random.default_rng(args.seed)
     rungs, base, done = [], None, False
@@ -325,7 +373,8 @@ def main(argv=None) -> int:
                 "minutes": (time.perf_counter() - start) / 60, "machine": "2 cores", "rows": len(data),
                 "observables": observables, "numbers": len(data) * len(observables),
                 "wavelengths": ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))}
-        write_report(out, meta, rungs, data_recip, (done or r == args.rounds - 1) and not args.joint and args.hold_index is None)
+        write_report(out, meta, rungs, data_recip, (done or r == args.rounds - 1) and not args.joint and args.hold_index is None,
+                     symmetry=symmetry)
         print(f"round {r + 1}: {rungs[-1]['change'] or 'no change'}; report rewritten in {out}", file=sys.stderr)
         if done:
             break
@@ -345,7 +394,7 @@ def main(argv=None) -> int:
                             "delta_elpd": float(diff.sum()), "delta_elpd_se": float(np.sqrt(len(diff) * np.var(diff)))},
                            inv, data) | {"held_index": args.hold_index}
         meta["minutes"] = (time.perf_counter() - start) / 60
-        write_report(out, meta, rungs, data_recip, not args.joint, held=held)
+        write_report(out, meta, rungs, data_recip, not args.joint, held=held, symmetry=symmetry)
     if args.joint:
         from spacepol.infer.inversion import invert
         from spacepol.infer.posterior import Posterior
@@ -359,7 +408,8 @@ def main(argv=None) -> int:
             joint.append(rung_record({"model": spec, "change": f"joint: {spec}", "delta_elpd": None, "delta_elpd_se": None},
                                      inv, joint_data))
             meta["minutes"] = (time.perf_counter() - start) / 60
-            write_report(out, meta, rungs, data_recip, len(joint) == 2 or rungs[0]["model"] == rungs[-1]["model"], joint, held)
+            write_report(out, meta, rungs, data_recip, len(joint) == 2 or rungs[0]["model"] == rungs[-1]["model"], joint, held,
+                         symmetry)
     return 0
 
 

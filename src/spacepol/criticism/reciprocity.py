@@ -72,3 +72,64 @@ def data_violation(data, pairs: np.ndarray | None = None) -> dict:
     out = _compare(forward, backward)
     out.update({"n_pairs": int(len(pairs)), "n_self_pairs": int(np.sum(pairs[:, 0] == pairs[:, 1]))})
     return out
+
+
+# Mirror symmetry of an isotropic surface: M(theta_i, theta_r, -dphi) = D M(theta_i, theta_r, dphi) D
+MIRROR = np.diag([1.0, 1.0, -1.0, -1.0])
+# Reciprocity and mirror symmetry together, where theta_i = theta_r: M = S M^T S at the same dphi
+SYMMETRIC_SIGNS = np.diag(RECIPROCITY_SIGNS) @ MIRROR
+_PAIRS = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
+
+
+def mirror_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b) of geometries measured at dphi and -dphi (out of the plane of incidence), with the
+    same theta_i, theta_r and wavelength."""
+    from ..infer.measured_noise import _keys, _wavelengths
+
+    wl = _wavelengths(data)
+    rows = {key: j for j, key in enumerate(_keys(data.theta_i, data.theta_r, data.dphi, wl, tolerance_deg))}
+    mirrored = _keys(data.theta_i, data.theta_r, -np.asarray(data.dphi, float), wl, tolerance_deg)
+    pairs = [(j, rows[key]) for j, key in enumerate(mirrored) if key in rows and j < rows[key]]
+    return np.array(pairs, int).reshape(-1, 2)
+
+
+def symmetry_checks(data, tolerance_deg: float = 0.01) -> dict:
+    """What the measurement says about its own symmetries, without any model (needs the Mueller matrix).
+
+    ``mirror``: over the mirror pairs, per normalised element the RMS of m(b) - D m(a) D (what an isotropic sample
+    gives: ~sqrt(2) x the element's noise) and of m(b) - m(a) (the scale of the structure that mirror symmetry
+    constrains); ``noise_from_mirror`` = the first / sqrt(2), an upper bound of the noise (anisotropy adds to it).
+    ``equal_angles``: at theta_i = theta_r out of the plane, reciprocity and mirror symmetry together require
+    m_ji = s_i s_j m_ij (s = diag(1, 1, 1, -1) in DESIGN's basis: m31 = m13, m32 = m23, m41 = -m14, m42 = -m24,
+    m43 = -m34, m21 = m12); per element pair the RMS of the part that breaks it, (m_ji - s_i s_j m_ij) / 2 (noise
+    alone gives ~noise / sqrt(2)), and of the part that obeys the opposite sign. A broken relation that the opposite
+    sign obeys at the noise level is structure that no reciprocal, mirror-symmetric model in this basis can fit."""
+    if data.mueller is None:
+        return {}
+    m = data.mueller / np.where(data.mueller[0, 0] > 0, data.mueller[0, 0], np.inf)
+    names = [f"m{i + 1}{j + 1}" for i in range(4) for j in range(4)][1:]
+    out: dict = {}
+    pairs = mirror_pairs(data, tolerance_deg)
+    if len(pairs):
+        a, b = pairs.T
+        symmetric = m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
+        plain = m[..., b] - m[..., a]
+        out["mirror"] = {"n_pairs": int(len(pairs)), "elements": {
+            name: {"rms_mirrored": _rms(symmetric[int(name[1]) - 1, int(name[2]) - 1]),
+                   "rms_unmirrored": _rms(plain[int(name[1]) - 1, int(name[2]) - 1]),
+                   "noise_from_mirror": _rms(symmetric[int(name[1]) - 1, int(name[2]) - 1]) / np.sqrt(2.0)}
+            for name in names}}
+    equal = np.isclose(data.theta_i, data.theta_r, atol=tolerance_deg) & (np.abs(np.sin(np.radians(data.dphi))) > 1e-3)
+    if equal.any():
+        s = np.diag(SYMMETRIC_SIGNS)
+        rows = {}
+        for i, j in _PAIRS:
+            x, y = m[i, j, equal], m[j, i, equal]
+            rows[f"m{i + 1}{j + 1}/m{j + 1}{i + 1}"] = {"rms_breaking": _rms((y - s[i] * s[j] * x) / 2),
+                                                      "rms_opposite_sign": _rms((y + s[i] * s[j] * x) / 2)}
+        out["equal_angles"] = {"n_rows": int(equal.sum()), "pairs": rows}
+    return out
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if np.size(x) else float("nan")

@@ -153,3 +153,34 @@ def test_ptfe_diagnosis_states_which_effects_improve_elpd(tmp_path):
     for r in confirmed:  # every refitted effect appears in the statement, on the side its flag says
         assert r["effect"] in html.split("Improve ELPD-LOO by more than 2 SE:")[1]
         assert r["significant"] == (r["delta_elpd"] > 2 * r["delta_elpd_se"] and r["delta_elpd"] > 4)
+
+
+def test_refits_asked_for_are_skipped_only_where_the_optima_already_decide(monkeypatch):
+    """diagnose's ``confirm`` refits (the slot alternatives weighed at the end of --rounds): a change whose optimum
+    alone differs from the base beyond 2 SE and any LOO correction is not refitted, and a change near the base is.
+    Control: with the pre-check off, the skipped change is refitted, and its refit is significant in the same
+    direction (the skip lost nothing); the close one comes out the same either way."""
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    from test_residuals import TRUTH, _data
+
+    from spacepol.criticism import diagnose as dg
+    from spacepol.physics import Model
+
+    data = _data("paper+polarized_diffuse", TRUTH, 9)
+    model = Model.from_string("paper+polarized_diffuse")
+    labels = ["remove polarized_diffuse", "replace shadowing by smith"]
+
+    def run():
+        return dg.diagnose(data, model, np.random.default_rng(3), top=0, progress=False, candidates=["smith", "polarized_diffuse"],
+                           confirm=labels)
+
+    report = {e["change"]: e for e in run()["ranking"]}
+    removed, swapped = report["remove polarized_diffuse"], report["replace shadowing by smith"]
+    assert removed["delta_elpd"] is None and removed["explanation"].startswith("Not refitted")
+    assert "significantly worse" in removed["explanation"]
+    assert swapped["delta_elpd"] is not None
+    monkeypatch.setattr(dg, "_plugin_decides", lambda *a: False)
+    control = {e["change"]: e for e in run()["ranking"]}
+    refit = control["remove polarized_diffuse"]
+    assert refit["significant"] is False and refit["delta_elpd"] < -2 * refit["delta_elpd_se"] and refit["delta_elpd"] < -4
+    assert control["replace shadowing by smith"]["delta_elpd"] is not None

@@ -136,6 +136,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         if value > c["screening_gain"] + base_best:
             c.update(screening_gain=float(value - base_best), optimum=theta)
             searched[model_key(c["model"])] = value, dict(zip(c["posterior"].priors.names, theta))
+    # changes refitted only because the caller asked (``confirm``: the slot alternatives diagnose --rounds weighs
+    # at its end) and that their optima alone already show to differ significantly are not refitted
+    decided = [c for c in to_confirm if c["change"] in confirm and _plugin_decides(c, base, base_post)]
+    to_confirm = [c for c in to_confirm if c not in decided]
     clock["leaders"] = time.perf_counter()
     confirmed = []
     for i, c in enumerate(to_confirm, start=1):
@@ -167,9 +171,13 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["explanation"] = _explain(c, base)
         ranking.append(entry)
     for c in [c for c in screened if c not in to_confirm]:
+        explanation = f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."
+        if "plugin_delta" in c:
+            explanation = (f"Not refitted: at the two optima its log likelihood differs from the model's by "
+                           f"{c['plugin_delta']:+.1f} +- {c['plugin_se']:.1f}, beyond 2 SE and any LOO correction "
+                           f"({c['plugin_margin']:.0f}); significantly {'better' if c['plugin_delta'] > 0 else 'worse'}.")
         ranking.append({"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-                        "significant": False, "screening_gain": c["screening_gain"],
-                        "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."})
+                        "significant": False, "screening_gain": c["screening_gain"], "explanation": explanation})
     verdict = "none"
     if confirmed and confirmed[0]["significant"]:
         lead = confirmed[0]
@@ -224,6 +232,28 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
             return inv
     return invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
                   tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
+
+
+# the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it
+# stands in for the LOO difference's (on PTFE's eight slot alternatives the LOO SE was 1.02-1.12 times it)
+PLUGIN_SE_SLACK = 1.25
+
+
+def _plugin_decides(c: dict, base, base_post: Posterior) -> bool:
+    """Whether candidate ``c`` differs from the base so clearly that its refit cannot change the verdict: the pointwise
+    log likelihood at its optimum minus the base's at the base's best draw sums to d with standard error s, and
+    |d| - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = the base's p_loo + 2 x the candidate's free
+    parameters (ELPD-LOO = plug-in log likelihood - p_loo; the margin bounds the change in p_loo). On PTFE at 0.633 um
+    (278 geometries, the eight slot alternatives of a five-effect model) the plug-in sums were within 17 of the
+    refitted delta ELPD-LOO, whose p_loo changed by up to 26. Records the figures in ``c`` when it decides."""
+    best = np.array([base.result.best[n] for n in base_post.priors.names], float)
+    d = c["posterior"].log_prob_pointwise(c["optimum"][None, :])[0] - base_post.log_prob_pointwise(best[None, :])[0]
+    delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
+    margin = float(base.loo.get("p_loo", 0.0)) + 2.0 * c["posterior"].ndim
+    if abs(delta) - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
+        c.update(plugin_delta=delta, plugin_se=se, plugin_margin=margin)
+        return True
+    return False
 
 
 def _say(text: str) -> None:

@@ -106,7 +106,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     names = sorted({w for label in labels for w in label.split() if w not in ("add", "remove", "replace", "by")})
     # the user's prior overrides that concern these models (the others belong to effects not weighed here)
     known = set(base.posterior.names) | {p.name for c in changes(model, data, names) for p in c.model.parameters}
-    report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=False,
+    report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=progress,
                       priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
                       posterior_method=posterior_method, searched=searched)
     return _equivalent(report, labels)

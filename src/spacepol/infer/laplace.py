@@ -50,6 +50,7 @@ from scipy.stats import multivariate_t
 
 from .diagnostics import PARETO_K_LIMIT, loo_fields
 from .posterior import Posterior
+from .psis import logsumexp_rows, psis_log_weights
 from .sampling_space import SamplingSpace
 
 MIN_EFFECTIVE_DRAWS = 400  # as emcee's ESS target
@@ -260,12 +261,12 @@ def importance_loo(log_likelihood: np.ndarray, raw_log_weights: np.ndarray, labe
     against the weighted mean log predictive density."""
     finite = np.isfinite(raw_log_weights)
     ll, raw = log_likelihood[finite], raw_log_weights[finite]
-    smoothed, k = az.psislw((raw[:, None] - ll).T, reff=1.0)  # (M, S)
-    pointwise = logsumexp(smoothed + ll.T, axis=1)
-    k = np.asarray(k, float).copy()
+    smoothed, k = psis_log_weights((raw[:, None] - ll).T, reff=1.0)  # (M, S): ArviZ's psislw, vectorised
+    smoothed += ll.T
+    pointwise = logsumexp_rows(smoothed)
     failed = ~np.isfinite(pointwise)
     weights = raw - logsumexp(raw)
-    lpd = logsumexp(weights[:, None] + ll, axis=0)  # the weighted in-sample log predictive density
+    lpd = logsumexp_rows(weights[None, :] + ll.T)  # the weighted in-sample log predictive density
     if failed.any():  # as diagnostics.loo: the in-sample density, flagged unreliable
         pointwise[failed] = lpd[failed]
         k[failed] = np.inf

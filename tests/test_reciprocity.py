@@ -79,7 +79,9 @@ def _symmetric_set(sigma, seed=0):
     rng = np.random.default_rng(seed)
     ti = np.concatenate([rng.uniform(10, 60, 150), np.full(150, 40.0)])
     tr = np.concatenate([rng.uniform(10, 60, 150), np.full(150, 40.0)])
-    dphi = np.concatenate([rng.uniform(20, 160, 150), rng.uniform(20, 160, 150)])
+    # distinct azimuths (two random ones within the pairing's 0.01 deg would pair with each other's mirror)
+    dphi = np.concatenate([rng.choice(np.arange(20.0, 160.0, 0.25), 150, replace=False),
+                           rng.choice(np.arange(20.0, 160.0, 0.25), 150, replace=False)])
     ti, tr, dphi = np.concatenate([ti, ti]), np.concatenate([tr, tr]), np.concatenate([dphi, -dphi])
     model = Model.from_string("specular+smith+volume")
     m = model.evaluate({"n": 1.4, "k": 0.3, "ks": 0.5, "sigma": 0.4, "w_vol": 0.8, "pc_vol": 0.5}, Geometry(ti, tr, dphi),
@@ -95,6 +97,10 @@ def test_symmetry_checks_measure_noise_and_catch_a_broken_relation():
     noise_from_mirror within 10 %: 600 pairs x 15 elements, Monte-Carlo error ~1.5 %), and at theta_i = theta_r the
     part that breaks reciprocity + mirror symmetry is noise / sqrt(2). Control: the same set with m13's sign flipped
     (an input basis whose S2 axis points the other way for one element) breaks m13/m31 far beyond it."""
+    exact = reciprocity.symmetry_checks(_symmetric_set(0.0))  # the library's reciprocal effects keep both to rounding
+    assert max(e["rms_mirrored"] for e in exact["mirror"]["elements"].values()) < 1e-12
+    assert max(p["rms_breaking"] for p in exact["equal_angles"]["pairs"].values()) < 1e-12
+    assert min(p["rms_opposite_sign"] for k, p in exact["equal_angles"]["pairs"].items() if k != "m14/m41") > 1e-3
     sigma = 0.01
     data = _symmetric_set(sigma)
     checks = reciprocity.symmetry_checks(data)

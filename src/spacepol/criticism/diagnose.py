@@ -147,7 +147,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             _say(f"[confirm {i}/{len(to_confirm)}] {c['change']}: posterior and PSIS-LOO "
                  f"({time.perf_counter() - clock['start']:.0f} s)")
         # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
+        fit_start = time.perf_counter()
         inv = fit_for_elpd(c["posterior"], c["optimum"], seed, max_steps, posterior_method)
+        if progress and posterior_method == "laplace" and inv.summary["diagnostics"].get("engine") != "laplace-is":
+            _say(f"  the Laplace approximation was not trusted there: emcee took {time.perf_counter() - fit_start:.0f} s")
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),

@@ -45,7 +45,6 @@ from spacepol.io import read_measurements  # noqa: E402
 from spacepol.io.atomic import save_figure, write_json, write_text  # noqa: E402
 from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
-from spacepol.observables.mueller import GROUPS as MUELLER_GROUPS  # noqa: E402
 from spacepol.physics.spectral import SpectralModel  # noqa: E402
 from spacepol.report.inversion_figures import mueller_residual_figure  # noqa: E402
 
@@ -226,46 +225,9 @@ def held_findings(final: dict, held: dict) -> list[str]:
 
 
 def symmetry_findings(symmetry: dict, rungs: list[dict]) -> list[str]:
-    """What the measurement's own symmetries say (``reciprocity.symmetry_checks``, no model): the noise its mirror
-    pairs show, and the part of it at theta_i = theta_r that no reciprocal, isotropic model in DESIGN's basis can fit."""
-    out = []
-    mirror = symmetry.get("mirror")
-    if mirror:
-        elements = mirror["elements"]
-        groups = {g: float(np.sqrt(np.mean([elements[e]["noise_from_mirror"] ** 2 for e in members])))
-                  for g, members in MUELLER_GROUPS.items()}
-        measured = {k.removeprefix("sigma_m_"): v["measured"] for k, v in rungs[-1].get("noise", {}).items()}
-        odd = [e for e in elements if elements[e]["rms_unmirrored"] > 1.3 * elements[e]["rms_mirrored"]]
-        out.append(f"Mirror symmetry, no model ({mirror['n_pairs']} pairs measured at dphi and -dphi): the "
-                   f"elements odd in dphi ({', '.join(odd)}) differ by "
-                   + ", ".join(f"{e} {elements[e]['rms_mirrored']:.3f}" for e in odd)
-                   + " RMS once mirrored (unmirrored: " + ", ".join(f"{elements[e]['rms_unmirrored']:.3f}" for e in odd)
-                   + "): the sample is isotropic to about the noise. The noise these pairs bound, per group: "
-                   + ", ".join(f"{g} {v:.4f}" + (f" (reciprocal pairs: {measured[g]:.4f})" if g in measured else "")
-                               for g, v in groups.items())
-                   + ": an upper bound (a slight anisotropy adds to it); where it exceeds the reciprocal pairs' figure, the "
-                   "misfit ratios above are at most that much too high.")
-    equal = symmetry.get("equal_angles")
-    if equal:
-        broken = {k: v for k, v in equal["pairs"].items() if v["rms_breaking"] > 1.5 * v["rms_opposite_sign"]}
-        kept = {k: v for k, v in equal["pairs"].items() if 1.5 * v["rms_breaking"] < v["rms_opposite_sign"]}
-        unclear = {k: v for k, v in equal["pairs"].items() if k not in broken and k not in kept}
-        if broken:
-            out.append(f"At theta_i = theta_r out of the plane ({equal['n_rows']} rows), reciprocity and mirror symmetry "
-                       "together require m31 = m13, m32 = m23, m41 = -m14, m42 = -m24, m43 = -m34 and m21 = m12 in DESIGN's "
-                       "basis (SCATMECH's: every reciprocal effect of the library obeys it to rounding). The data break "
-                       + ", ".join(f"{k} (the breaking part {v['rms_breaking']:.4f} RMS, the opposite relation's "
-                                   f"{v['rms_opposite_sign']:.4f})" for k, v in broken.items())
-                       + "; they keep " + (", ".join(f"{k} ({v['rms_breaking']:.4f} vs {v['rms_opposite_sign']:.4f})"
-                                                     for k, v in kept.items()) or "none")
-                       + ("; within a factor 1.5 either way: " + ", ".join(
-                           f"{k} ({v['rms_breaking']:.4f} vs {v['rms_opposite_sign']:.4f})" for k, v in unclear.items())
-                          if unclear else "")
-                       + ". No reciprocal, isotropic model in this basis can fit the breaking part: it is an anisotropy "
-                       "of the sample (Germer & Patrick, Proc. SPIE 8160, 81600D (2011), saw one in sintered PTFE) or a "
-                       "difference of basis on the instrument's out-of-plane rows, and it stays in the residuals of every "
-                       "model here.")
-    return out
+    """What the measurement's own symmetries say, beside the noise the reciprocal pairs measured in the last round."""
+    measured = {k.removeprefix("sigma_m_"): v["measured"] for k, v in rungs[-1].get("noise", {}).items()}
+    return reciprocity.symmetry_findings(symmetry, measured)
 
 
 def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, done: bool, joint=(), held=None,

@@ -115,3 +115,7 @@ def test_symmetry_checks_measure_noise_and_catch_a_broken_relation():
     broken.mueller[0, 2] *= -1
     pair = reciprocity.symmetry_checks(broken)["equal_angles"]["pairs"]["m13/m31"]
     assert pair["rms_breaking"] > 3 * sigma and pair["rms_opposite_sign"] < sigma
+    # in words: the broken relation is named, and a clean set has no such finding
+    words = reciprocity.symmetry_findings(reciprocity.symmetry_checks(broken), {"pol": 0.01})
+    assert any("The data break m13/m31" in w for w in words) and "(reciprocal pairs: 0.0100)" in words[0]
+    assert not any("The data break" in w for w in reciprocity.symmetry_findings(checks))

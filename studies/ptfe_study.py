@@ -324,6 +324,7 @@ def main(argv=None) -> int:
             observables = fits[0]["_inversion"].posterior.likelihood.observables
         if len(fits) == 1:  # nothing significant: the loop stops here
             rungs[-1]["equivalent"] = result["rounds"][0].get("equivalent", [])
+            rungs[-1]["better"] = result["rounds"][0].get("better", [])
             done = True
         else:
             rungs.append(rung_record(result["rounds"][1], fits[1]["_inversion"], data))

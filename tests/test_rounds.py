@@ -175,3 +175,29 @@ def test_ladder_replays_a_path(swap_path, tmp_path):
     rungs = json.loads((tmp_path / "l.json").read_text())["rungs"]
     assert [r["model"] for r in rungs] == [r["model"] for r in report["rounds"]]
     assert rungs[-1]["chi2_red"] < 1.5
+
+
+def test_a_slot_alternative_better_than_the_final_model_is_reported():
+    """The last pass searches each slot alternative globally; one that comes out significantly better than the model
+    the rounds stopped at (refitted, or decided from the two optima) is named in the conclusion, the best first;
+    equivalent and worse ones are not."""
+    from spacepol.criticism.rounds import _better, _conclusion
+
+    ranking = [
+        {"change": "replace body by lambertian", "delta_elpd": 20.0, "delta_elpd_se": 5.0, "significant": True},
+        {"change": "remove body", "delta_elpd": None, "delta_elpd_se": None, "significant": False,
+         "plugin_delta": 300.0, "plugin_se": 20.0},
+        {"change": "remove shadowing", "delta_elpd": None, "delta_elpd_se": None, "significant": False,
+         "plugin_delta": -300.0, "plugin_se": 20.0},
+        {"change": "replace shadowing by smith", "delta_elpd": 1.0, "delta_elpd_se": 3.0, "significant": False},
+        {"change": "add ggx", "delta_elpd": 50.0, "delta_elpd_se": 5.0, "significant": True},  # not a slot alternative
+    ]
+    labels = [e["change"] for e in ranking[:4]]
+    better = _better({"ranking": ranking}, labels)
+    assert [e["change"] for e in better] == ["remove body", "replace body by lambertian"]
+    assert better[0]["plug_in"] and not better[1]["plug_in"]
+    final = {"model": "paper", "fit": {"chi2_red": 1.0}, "inferred_noise": {}, "structured": False,
+             "residual_structure": [], "equivalent": [], "better": better}
+    text = _conclusion([dict(final, better=[], equivalent=[]), dict(final, change="add lambertian")], [{}])
+    assert "significantly better" in text and "remove body (+300.0 +- 20.0, from the two optima)" in text
+    assert "significantly better" not in _conclusion([final | {"better": []}, dict(final, change="x", better=[])], [{}])

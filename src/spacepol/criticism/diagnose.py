@@ -179,8 +179,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             explanation = (f"Not refitted: at the two optima its log likelihood differs from the model's by "
                            f"{c['plugin_delta']:+.1f} +- {c['plugin_se']:.1f}, beyond 2 SE and any LOO correction "
                            f"({c['plugin_margin']:.0f}); significantly {'better' if c['plugin_delta'] > 0 else 'worse'}.")
-        ranking.append({"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-                        "significant": False, "screening_gain": c["screening_gain"], "explanation": explanation})
+        entry = {"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
+                 "significant": False, "screening_gain": c["screening_gain"], "explanation": explanation}
+        if "plugin_delta" in c:
+            entry.update(plugin_delta=c["plugin_delta"], plugin_se=c["plugin_se"])
+        ranking.append(entry)
     verdict = "none"
     if confirmed and confirmed[0]["significant"]:
         lead = confirmed[0]

@@ -62,8 +62,9 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
         if report["verdict"] == "none":
             simplification = _simplification(report)
             if simplification is None:
-                path[-1]["equivalent"] = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
-                                                           priors, report["_base"], posterior_method, searched)
+                path[-1]["equivalent"], path[-1]["better"] = _slot_equivalents(
+                    data, current, rng, seed, observables, candidates, progress, priors, report["_base"], posterior_method,
+                    searched)
                 break
         lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -92,14 +93,16 @@ def _simplification(report: dict):
 
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
-                      posterior_method: str = "laplace", searched: dict | None = None) -> list[dict]:
+                      posterior_method: str = "laplace", searched: dict | None = None) -> tuple[list[dict], list[dict]]:
     """Where the path stopped: refit every other member of each of the final model's slots (and the slot
     emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
-    the conclusion can say which parts of the final model the data pin down."""
+    the conclusion can say which parts of the final model the data pin down. Returns (equivalent, better): the
+    second, alternatives significantly better than the final model (the pass searches each globally, where the
+    round's screening searched near the model and may have missed their best mode)."""
     slots = {e.slot for e in model.effects if e.slot}
     labels = slot_alternatives(model, data, slots, candidates)
     if not labels:
-        return []
+        return [], []
     if progress:
         print(f"  the path stopped at {model.name}: weighing each slot's other members ({len(labels)} refits)",
               file=sys.stderr, flush=True)
@@ -109,7 +112,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=progress,
                       priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
                       posterior_method=posterior_method, searched=searched)
-    return _equivalent(report, labels)
+    return _equivalent(report, labels), _better(report, labels)
 
 
 def _equivalent(report: dict, labels) -> list[dict]:
@@ -120,6 +123,21 @@ def _equivalent(report: dict, labels) -> list[dict]:
         if e["change"] in labels and e["delta_elpd"] is not None and not significant(abs(e["delta_elpd"]), e["delta_elpd_se"]):
             out.append({k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se")})
     return out
+
+
+def _better(report: dict, labels) -> list[dict]:
+    """Slot alternatives significantly better than the final model: refitted (delta ELPD-LOO > 2 SE and > 4) or
+    decided by their optima alone (``diagnose._plugin_decides``: the plug-in difference and its SE, flagged)."""
+    out = []
+    for e in report["ranking"]:
+        if e["change"] not in labels:
+            continue
+        if e["delta_elpd"] is not None and e["significant"] and e["delta_elpd"] > 0:
+            out.append({k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se")} | {"plug_in": False})
+        elif e.get("plugin_delta") is not None and e["plugin_delta"] > 0:
+            out.append({"change": e["change"], "delta_elpd": e["plugin_delta"], "delta_elpd_se": e["plugin_se"],
+                        "plug_in": True})
+    return sorted(out, key=lambda e: -e["delta_elpd"])
 
 
 def _conclusion(path: list[dict], reports: list[dict]) -> str:
@@ -139,6 +157,13 @@ def _conclusion(path: list[dict], reports: list[dict]) -> str:
                  "does not have (or one the rounds did not reach).")
     else:
         text += f" Explained: the residuals of the final model {final['model']} look like noise ({fit})."
+    if final.get("better"):
+        text += (" But the last pass, which searched each slot alternative globally, found changes significantly better "
+                 "than the final model: " + ", ".join(
+                     f"{e['change']} ({e['delta_elpd']:+.1f} +- {e['delta_elpd_se']:.1f}"
+                     + (", from the two optima" if e["plug_in"] else "") + ")" for e in final["better"])
+                 + ". The rounds' screening, which searches near the current model, missed that mode: start again from "
+                   "the changed model (diagnose --model).")
     if final.get("equivalent"):
         text += (" The data cannot tell the final model from these slot alternatives (neither significantly better): "
                  + ", ".join(f"{e['change']} ({e['delta_elpd']:+.1f} +- {e['delta_elpd_se']:.1f})" for e in final["equivalent"]) + ".")

@@ -138,7 +138,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             searched[model_key(c["model"])] = value, dict(zip(c["posterior"].priors.names, theta))
     # changes refitted only because the caller asked (``confirm``: the slot alternatives diagnose --rounds weighs
     # at its end) and that their optima alone already show to differ significantly are not refitted
-    decided = [c for c in to_confirm if c["change"] in confirm and _plugin_decides(c, base, base_post)]
+    asked = [c for c in to_confirm if c["change"] in confirm]
+    if asked:
+        best = np.array([base.result.best[n] for n in base_post.priors.names], float)
+        base_pointwise = base_post.log_prob_pointwise(best[None, :])[0]
+    decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(base.loo.get("p_loo", 0.0)))]
     to_confirm = [c for c in to_confirm if c not in decided]
     clock["leaders"] = time.perf_counter()
     confirmed = []
@@ -174,15 +178,14 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["explanation"] = _explain(c, base)
         ranking.append(entry)
     for c in [c for c in screened if c not in to_confirm]:
-        explanation = f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."
-        if "plugin_delta" in c:
-            explanation = (f"Not refitted: at the two optima its log likelihood differs from the model's by "
-                           f"{c['plugin_delta']:+.1f} +- {c['plugin_se']:.1f}, beyond 2 SE and any LOO correction "
-                           f"({c['plugin_margin']:.0f}); significantly {'better' if c['plugin_delta'] > 0 else 'worse'}.")
         entry = {"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-                 "significant": False, "screening_gain": c["screening_gain"], "explanation": explanation}
+                 "significant": False, "screening_gain": c["screening_gain"],
+                 "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."}
         if "plugin_delta" in c:
-            entry.update(plugin_delta=c["plugin_delta"], plugin_se=c["plugin_se"])
+            entry.update(plugin_delta=c["plugin_delta"], plugin_se=c["plugin_se"], explanation=(
+                f"Not refitted: at the two optima its log likelihood differs from the model's by {c['plugin_delta']:+.1f} "
+                f"+- {c['plugin_se']:.1f}, beyond 2 SE and any LOO correction ({c['plugin_margin']:.0f}); significantly "
+                f"{'better' if c['plugin_delta'] > 0 else 'worse'}."))
         ranking.append(entry)
     verdict = "none"
     if confirmed and confirmed[0]["significant"]:
@@ -245,17 +248,16 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
 PLUGIN_SE_SLACK = 1.25
 
 
-def _plugin_decides(c: dict, base, base_post: Posterior) -> bool:
+def _plugin_decides(c: dict, base_pointwise: np.ndarray, base_p_loo: float) -> bool:
     """Whether candidate ``c`` differs from the base so clearly that its refit cannot change the verdict: the pointwise
-    log likelihood at its optimum minus the base's at the base's best draw sums to d with standard error s, and
+    log likelihood at its optimum minus the base's at the base's best draw (``base_pointwise``) sums to d with standard error s, and
     |d| - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = the base's p_loo + 2 x the candidate's free
-    parameters (ELPD-LOO = plug-in log likelihood - p_loo; the margin bounds the change in p_loo). On PTFE at 0.633 um
+    parameters (``base_p_loo``; ELPD-LOO = plug-in log likelihood - p_loo; the margin bounds the change in p_loo). On PTFE at 0.633 um
     (278 geometries, the eight slot alternatives of a five-effect model) the plug-in sums were within 17 of the
     refitted delta ELPD-LOO, whose p_loo changed by up to 26. Records the figures in ``c`` when it decides."""
-    best = np.array([base.result.best[n] for n in base_post.priors.names], float)
-    d = c["posterior"].log_prob_pointwise(c["optimum"][None, :])[0] - base_post.log_prob_pointwise(best[None, :])[0]
+    d = c["posterior"].log_prob_pointwise(c["optimum"][None, :])[0] - base_pointwise
     delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
-    margin = float(base.loo.get("p_loo", 0.0)) + 2.0 * c["posterior"].ndim
+    margin = base_p_loo + 2.0 * c["posterior"].ndim
     if abs(delta) - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
         c.update(plugin_delta=delta, plugin_se=se, plugin_margin=margin)
         return True

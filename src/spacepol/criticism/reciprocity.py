@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..infer.measured_noise import RECIPROCITY_SIGNS, reciprocal_pairs
+from ..infer.measured_noise import RECIPROCITY_SIGNS, mirror_pairs, reciprocal_pairs
 from ..observables.mueller import GROUPS
 from ..physics.geometry import Geometry
 
@@ -82,18 +82,6 @@ SYMMETRIC_SIGNS = np.diag(RECIPROCITY_SIGNS) @ MIRROR
 _PAIRS = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
 
 
-def mirror_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
-    """(K, 2) row indices (a, b) of geometries measured at dphi and -dphi (out of the plane of incidence), with the
-    same theta_i, theta_r and wavelength."""
-    from ..infer.measured_noise import _keys, _wavelengths
-
-    wl = _wavelengths(data)
-    rows = {key: j for j, key in enumerate(_keys(data.theta_i, data.theta_r, data.dphi, wl, tolerance_deg))}
-    mirrored = _keys(data.theta_i, data.theta_r, -np.asarray(data.dphi, float), wl, tolerance_deg)
-    pairs = [(j, rows[key]) for j, key in enumerate(mirrored) if key in rows and j < rows[key]]
-    return np.array(pairs, int).reshape(-1, 2)
-
-
 def symmetry_checks(data, tolerance_deg: float = 0.01) -> dict:
     """What the measurement says about its own symmetries, without any model (needs the Mueller matrix).
 
@@ -115,11 +103,13 @@ def symmetry_checks(data, tolerance_deg: float = 0.01) -> dict:
         a, b = pairs.T
         symmetric = m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
         plain = m[..., b] - m[..., a]
-        out["mirror"] = {"n_pairs": int(len(pairs)), "elements": {
-            name: {"rms_mirrored": _rms(symmetric[int(name[1]) - 1, int(name[2]) - 1]),
-                   "rms_unmirrored": _rms(plain[int(name[1]) - 1, int(name[2]) - 1]),
-                   "noise_from_mirror": _rms(symmetric[int(name[1]) - 1, int(name[2]) - 1]) / np.sqrt(2.0)}
-            for name in names}}
+        elements = {}
+        for name in names:
+            i, j = int(name[1]) - 1, int(name[2]) - 1
+            mirrored = _rms(symmetric[i, j])
+            elements[name] = {"rms_mirrored": mirrored, "rms_unmirrored": _rms(plain[i, j]),
+                              "noise_from_mirror": mirrored / np.sqrt(2.0)}
+        out["mirror"] = {"n_pairs": int(len(pairs)), "elements": elements}
     equal = np.isclose(data.theta_i, data.theta_r, atol=tolerance_deg) & (np.abs(np.sin(np.radians(data.dphi))) > 1e-3)
     if equal.any():
         s = np.diag(SYMMETRIC_SIGNS)

@@ -68,17 +68,29 @@ def _wavelengths(data) -> np.ndarray:
     return np.zeros(len(data)) if data.wavelength_um is None else np.asarray(data.wavelength_um, float)
 
 
-def reciprocal_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
-    """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
-    (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
-    and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
+def _matched(data, theta_i, theta_r, dphi, tolerance_deg: float, keep) -> np.ndarray:
+    """(K, 2) row indices (j, k): row j moved to (theta_i[j], theta_r[j], dphi[j]) is row k's measured geometry (same
+    wavelength), for the pairs ``keep(j, k)`` accepts."""
     wl = _wavelengths(data)
     rows: dict = {}
     for j, key in enumerate(_keys(data.theta_i, data.theta_r, data.dphi, wl, tolerance_deg)):
         rows.setdefault(key, []).append(j)
-    swapped = _keys(data.theta_r, data.theta_i, -np.asarray(data.dphi, float), wl, tolerance_deg)
-    pairs = [(j, k) for j, key in enumerate(swapped) for k in rows.get(key, []) if j <= k]
+    moved = _keys(theta_i, theta_r, dphi, wl, tolerance_deg)
+    pairs = [(j, k) for j, key in enumerate(moved) for k in rows.get(key, []) if keep(j, k)]
     return np.array(pairs, int).reshape(-1, 2)
+
+
+def reciprocal_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b), a < b or a = b, of measured geometries that are each other's swap
+    (theta_i and theta_r exchanged, dphi of opposite sign, same wavelength). a = b where theta_i = theta_r
+    and dphi is 0 or 180 deg: reciprocity then constrains the matrix itself (m12 = m21, m13 = -m31, ...)."""
+    return _matched(data, data.theta_r, data.theta_i, -np.asarray(data.dphi, float), tolerance_deg, lambda j, k: j <= k)
+
+
+def mirror_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
+    """(K, 2) row indices (a, b), a < b, of geometries measured at dphi and -dphi with the same theta_i, theta_r and
+    wavelength (an isotropic sample's mirror images)."""
+    return _matched(data, data.theta_i, data.theta_r, -np.asarray(data.dphi, float), tolerance_deg, lambda j, k: j < k)
 
 
 def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
@@ -142,4 +154,4 @@ def measure(likelihood) -> dict[str, MeasuredNoise]:
     return out
 
 
-__all__ = ["MeasuredNoise", "RECIPROCITY_SIGNS", "measure", "reciprocal_pairs", "repeated_pairs"]
+__all__ = ["MeasuredNoise", "RECIPROCITY_SIGNS", "measure", "mirror_pairs", "reciprocal_pairs", "repeated_pairs"]

@@ -155,7 +155,8 @@ def _effect_parameters(name: str) -> list[str]:
 def run_demo(out: Path, seed: int = 0) -> None:
     out.mkdir(parents=True, exist_ok=True)
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
-    data = read_measurements(source).at_wavelength(0.633).in_plane()
+    measured = read_measurements(source).at_wavelength(0.633)
+    data = measured.in_plane()
     print(f"1/5 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
     forward_lines = forward_comparison(data, out)
     for line in forward_lines:
@@ -185,7 +186,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
     print("   " + significance_statement(ptfe_report))
     # what the measurement says about itself, no model: its out-of-plane rows hold the mirror pairs and the
     # theta_i = theta_r rows that the plane of incidence lacks
-    itself = reciprocity.symmetry_findings(reciprocity.symmetry_checks(read_measurements(source).at_wavelength(0.633)))
+    itself = reciprocity.symmetry_findings(reciprocity.symmetry_checks(measured))
 
     print("5/5 detecting a target of this material against the daytime sky: the paper's Table 3 as distributions")
     scenario = default_scenario()

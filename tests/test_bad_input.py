@@ -99,6 +99,11 @@ def test_observables(capsys, here, observables, words):
     (["sky", "--lat", "95", "--lon", "0", "--time", "2026-11-22T12:00Z"], ["--lat", "latitude"]),
     (["sky", "--lat", "10", "--lon", "0", "--time", "2026-11-22T12:00Z", "--p-max", "-1"], ["--p-max"]),
     (["sky", "--lat", "10", "--lon", "0", "--time", "2026-11-22T12:00Z", "--direction", "95,10"], ["--direction"]),
+    (["sky", "--lat", "10", "--lon", "0", "--time", "2026-11-22T12:00Z", "--direction", "30,nan"], ["--direction", "azimuth"]),
+    (["forward", "good.csv", "--set", "ks=1e300", "--out", "f.csv"], ["ks = 1e+300", "[0, 1]"]),
+    (["synth", "--set", "rho_d=1e300", "--out", "s.csv"], ["rho_d = 1e+300", "[0, 1]"]),
+    (["forward", "good.csv", "--set", "n=1e300", "--out", "f.csv"], ["n = 1e+300", "no finite output"]),
+    (["synth", "--set", "k=1e300", "--out", "s.csv"], ["k = 1e+300", "no finite output"]),
 ])
 def test_numbers_that_must_be_finite_or_positive(capsys, here, args, words):
     expect_error(capsys, here, args, *words)
@@ -234,10 +239,32 @@ def test_dates_outside_what_the_ephemeris_takes(capsys, here, time):
     ("theta_i,theta_r,dop\n", ["no data rows"]),
     ("theta_i,theta_r,dop\n10,20\n", ["line 2", "fields"]),
     ("\x00\x01\x02binary", ["w.csv"]),
+    (GOOD_CSV + ",,\n", ["line 17", "empty fields"]),
+    ("theta_i,theta_r,s0,s1,s2\n" + "".join(f"{ti},{tr},1.0,{1.5 if tr == 35 else 0.3},0.1\n"
+                                            for ti in (10, 30, 50) for tr in (5, 20, 35, 50, 65)),
+     ["line 4", "s1", "above s0"]),
 ])
 def test_malformed_measurement_files(capsys, here, text, words):
     (here / "w.csv").write_text(text)
     expect_error(capsys, here, ["run", "w.csv", "--out", "r"], "w.csv", *words)
+
+
+@pytest.mark.parametrize("observables", ["q", None])
+def test_a_stokes_row_above_s0_is_refused_whatever_is_fitted(capsys, here, observables):
+    rows = "".join(f"{ti},{tr},1.0,{1.2 if tr == 50 else 0.3},0.1\n" for ti in (10, 30, 50) for tr in (5, 20, 35, 50, 65))
+    (here / "st.csv").write_text("theta_i,theta_r,s0,s1,s2\n" + rows)
+    extra = ["--observables", observables] if observables else []
+    expect_error(capsys, here, ["run", "st.csv", "--out", "r", *extra], "st.csv", "line 5", "above s0")
+
+
+def test_blank_lines_and_fully_polarized_stokes_rows_are_still_read(here):
+    """The controls: a blank line is skipped (not a row of empty fields), and a Stokes vector exactly at DOP 1 is possible."""
+    from spacepol.io import read_measurements
+
+    (here / "b.csv").write_text(GOOD_CSV.replace("\n10,20,", "\n\n10,20,") + "\n  \n")
+    assert len(read_measurements(here / "b.csv")) == 15
+    (here / "s.csv").write_text("theta_i,theta_r,s0,s1,s2,s3\n10,20,1.0,0.6,0.0,0.8\n30,20,2.0,0.0,-2.0,0.0\n")
+    assert len(read_measurements(here / "s.csv")) == 2
 
 
 def test_a_folder_or_a_missing_file_as_data(capsys, here):

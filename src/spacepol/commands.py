@@ -46,7 +46,7 @@ def forward(args) -> int:
     model = build_model(args.model)
     values = parse_settings(args.set, model)
     data = read_measurements(args.geometry, require_observable=False)
-    prediction = model.check_plugins({**model.defaults(), **values}, data.geometry)
+    prediction = model.check_plugins({**model.defaults(), **values}, data.geometry).require_finite(values, model.name)
     columns = _prediction_columns(data.geometry, prediction)
     if data.wavelength_um is not None:
         columns["wavelength_um"] = data.wavelength_um
@@ -59,7 +59,8 @@ def forward(args) -> int:
 def synth(args) -> int:
     check_output_file(args.out)
     model = build_model(args.model)
-    values = {**model.defaults(), **parse_settings(args.set, model)}
+    settings = parse_settings(args.set, model)
+    values = {**model.defaults(), **settings}
     if args.noise_dop < 0 or (args.noise_brdf is not None and args.noise_brdf < 0):
         raise ParameterError("noise levels must be >= 0")
     if args.geometry:
@@ -74,7 +75,7 @@ def synth(args) -> int:
     if wavelength is not None:
         geometry = Geometry(geometry.theta_i, geometry.theta_r, geometry.dphi, wavelength)
     rng = np.random.default_rng(args.seed)
-    prediction = model.check_plugins(values, geometry)
+    prediction = model.check_plugins(values, geometry).require_finite(settings, model.name)
     dop = np.clip(prediction.dop + rng.normal(0.0, args.noise_dop, geometry.size), 0.0, 1.0)
     columns = {"theta_i": geometry.theta_i, "theta_r": geometry.theta_r, "dphi": geometry.dphi, "dop": dop}
     if args.noise_dop > 0:
@@ -469,6 +470,8 @@ def _parse_direction(text: str) -> tuple[float, float]:
         raise ParameterError(f"--direction '{text}': expected ZENITH,AZIMUTH in degrees, e.g. 60,101.5") from None
     if not 0 <= zen <= 90:
         raise ParameterError(f"--direction '{text}': zenith angle must lie in [0, 90] deg")
+    if not np.isfinite(az):
+        raise ParameterError(f"--direction '{text}': azimuth {az:g} deg is not a finite number")
     return zen, az
 
 

@@ -196,8 +196,10 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     reader = csv.reader(_io.StringIO("\n".join(lines[skip + 1 :])))
     for offset, row in enumerate(reader, start=1):
         line = header_line + offset
-        if not row or all(not cell.strip() for cell in row):
+        if is_blank_row(row):
             continue
+        if all(not cell.strip() for cell in row):
+            raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         if len(row) != len(header):
             raise InputFileError(path, f"{len(row)} fields, header has {len(header)}", line=line)
         values = {}
@@ -205,6 +207,8 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
             values[column] = _number(cell.strip(), path, line, column)
             _check_value(values[column], column, path, line)
             columns[column].append(values[column])
+        if "s0" in values:
+            _check_stokes(values, path, line)
         if "m21" in values:
             check_first_column(values["m21"], values["m31"], values["m41"], path, line, "m21, m31, m41")
     if not columns["theta_i"]:
@@ -240,6 +244,12 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
         metadata=meta,
         source=str(path),
     )
+
+
+def is_blank_row(row: list[str]) -> bool:
+    """Whether a parsed CSV row is a blank line (no separator, at most whitespace): skipped. A row of separators
+    alone is not blank: its fields are empty, which is an error."""
+    return len(row) <= 1 and all(not cell.strip() for cell in row)
 
 
 def _check_mueller_header(header, path, line):
@@ -285,6 +295,16 @@ def _mueller(arrays, n):
                 errors[i, j] = err
     has_errors = "m_err" in arrays or "m12_err" in arrays
     return mueller, (errors if has_errors else None)
+
+
+def _check_stokes(values: dict, path, line) -> None:
+    """A Stokes row must be a possible polarization state: its polarized part no larger than s0 (a degree of
+    polarization in [0, 1], as the dop column's check)."""
+    polarized = float(np.sqrt(values["s1"] ** 2 + values["s2"] ** 2 + values.get("s3", 0.0) ** 2))
+    if polarized > values["s0"]:
+        parts = "s1, s2, s3" if "s3" in values else "s1, s2"
+        raise InputFileError(path, f"Stokes vector with |({parts})| = {polarized:g} above s0 = {values['s0']:g} "
+                                   "(a degree of polarization above 1)", line=line, column="s1")
 
 
 def _check_value(value, column, path, line):

@@ -30,7 +30,7 @@ def _wrap_deg(angle):
 
 
 def read_nist_rows(path, header, lines, header_line, meta):
-    from .measurements import Dataset, _number, check_first_column, check_mueller_element
+    from .measurements import Dataset, _number, check_first_column, check_mueller_element, is_blank_row
 
     if len(header) != 21:
         raise InputFileError(path, f"NIST Mueller layout needs 21 columns, header has {len(header)}", line=header_line)
@@ -38,8 +38,10 @@ def read_nist_rows(path, header, lines, header_line, meta):
     rows = []
     for offset, row in enumerate(csv.reader(_io.StringIO("\n".join(lines))), start=1):
         line = header_line + offset
-        if not row or all(not c.strip() for c in row):
+        if is_blank_row(row):
             continue
+        if all(not c.strip() for c in row):
+            raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         if len(row) != 21:
             raise InputFileError(path, f"{len(row)} fields, header has 21", line=line)
         values = [_number(c.strip(), path, line, header[i]) for i, c in enumerate(row)]

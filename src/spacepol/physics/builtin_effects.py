@@ -20,7 +20,7 @@ class Specular(Effect):
         Parameter("n", "", Uniform(0.1, 5.0), 1.5, "real part of the complex refractive index N = n + ik", physical=(1e-6, np.inf)),
         Parameter("k", "", Uniform(0.0, 20.0), 0.0, "extinction coefficient, imaginary part of N", physical=(0.0, np.inf)),
         Parameter("sigma", "", Uniform(0.02, 0.8), 0.2, "facet slope standard deviation per axis (eq 1)", physical=(1e-6, np.inf)),
-        Parameter("ks", "", Uniform(0.0, 1.0), 0.5, "specular weight k_s of f = f_dd + k_s f_sp (eq 10)", physical=(0.0, np.inf)),
+        Parameter("ks", "", Uniform(0.0, 1.0), 0.5, "specular weight k_s of f = f_dd + k_s f_sp (eq 10)", physical=(0.0, 1.0)),
     )
     description = (
         "Mirror-like reflection from randomly tilted microfacets (paper eqs 1-6, 20-21). Facet "
@@ -133,7 +133,7 @@ class Smith(Effect):
 class Body(Effect):
     name = "body"
     parameters = (
-        Parameter("rho_d", "", Uniform(0.0, 1.0), 0.1, "Kubelka-Munk body reflectance rho_d (eq 12)", physical=(0.0, np.inf)),
+        Parameter("rho_d", "", Uniform(0.0, 1.0), 0.1, "Kubelka-Munk body reflectance rho_d (eq 12)", physical=(0.0, 1.0)),
     )
     reciprocal = False
     description = (
@@ -154,7 +154,7 @@ class Body(Effect):
 class PolarizedDiffuse(Effect):
     name = "polarized_diffuse"
     parameters = (
-        Parameter("rho_pd", "", Uniform(0.0, 1.0), 0.1, "albedo of the subsurface Lambertian light", physical=(0.0, np.inf)),
+        Parameter("rho_pd", "", Uniform(0.0, 1.0), 0.1, "albedo of the subsurface Lambertian light", physical=(0.0, 1.0)),
     )
     requires = ("specular",)
     description = (

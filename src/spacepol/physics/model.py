@@ -50,6 +50,22 @@ class Prediction:
         xp = array_module(self.stokes)
         return 0.5 * xp.degrees(xp.arctan2(self.stokes[2], self.stokes[1]))
 
+    def require_finite(self, params: dict, model_name: str) -> "Prediction":
+        """This prediction, or a ParameterError naming the parameters where the model's output overflowed or is not
+        a number (values far outside any measured material: the numbers written would be meaningless)."""
+        stokes = np.asarray(self.stokes, float)
+        # a Stokes vector whose squares overflow gives a DOP of 0 or 1 that means nothing
+        bad = ~np.isfinite(stokes) | (np.abs(stokes) > _LARGEST_STOKES) | ~np.isfinite(np.asarray(self.dop, float))
+        if np.any(bad):
+            given = ", ".join(f"{k} = {float(v):g}" for k, v in params.items() if np.ndim(v) == 0)
+            raise ParameterError(f"model '{model_name}' gives no finite output at {given}: "
+                                 "a value too large or too small for the model to evaluate")
+        return self
+
+
+# Stokes components above this overflow when squared (the DOP's sqrt(s1^2 + s2^2 + s3^2))
+_LARGEST_STOKES = 1e150
+
 
 class Model:
     """A pBRDF model: a list of effects (registered names, classes or instances) that together predict the

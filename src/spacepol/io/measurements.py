@@ -12,110 +12,17 @@ from __future__ import annotations
 
 import csv
 import io as _io
-from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputFileError
-from ..physics.geometry import Geometry
+from .cells import check_first_column, check_mueller_element, is_blank_row, parse_number
+from .dataset import GEOMETRY_COLUMNS, KNOWN_COLUMNS, MUELLER_COLUMNS, OBSERVABLE_COLUMNS, Dataset
+from .nist import is_nist_header, read_nist_rows
 
-GEOMETRY_COLUMNS = ("theta_i", "theta_r", "dphi", "wavelength_um")
-MUELLER_COLUMNS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]  # m12 ... m44 = M_ij / M_11
-OBSERVABLE_COLUMNS = (("dop", "dop_err", "brdf", "brdf_err", "s0", "s1", "s2", "s3", "aop", "aop_err")
-                      + MUELLER_COLUMNS + ("m_err",) + tuple(f"{m}_err" for m in MUELLER_COLUMNS))
-KNOWN_COLUMNS = GEOMETRY_COLUMNS + OBSERVABLE_COLUMNS
-
-
-@dataclass
-class Dataset:
-    """Measurements at N geometries.  Absent observables are ``None``; angles in degrees."""
-
-    theta_i: np.ndarray
-    theta_r: np.ndarray
-    dphi: np.ndarray
-    wavelength_um: np.ndarray | None = None
-    dop: np.ndarray | None = None
-    dop_err: np.ndarray | None = None
-    brdf: np.ndarray | None = None  # sr^-1
-    brdf_err: np.ndarray | None = None
-    stokes: np.ndarray | None = None  # (4, N): s0..s3 for unpolarized incidence (s3 may be 0)
-    aop: np.ndarray | None = None  # deg
-    aop_err: np.ndarray | None = None
-    mueller: np.ndarray | None = None  # (4, 4, N) BRDF Mueller matrix (sr^-1; M_11 = 1 when no BRDF was measured)
-    mueller_err: np.ndarray | None = None  # (4, 4, N) 1-sigma errors of the normalised elements m_ij (M_11's unused)
-    metadata: dict = field(default_factory=dict)
-    source: str = ""
-
-    def __len__(self):
-        return len(self.theta_i)
-
-    # Normalised Stokes parameters q = S1/S0, u = S2/S0 (s-polarized light has q > 0).
-    @property
-    def q(self):
-        return None if self.stokes is None else self.stokes[1] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
-
-    @property
-    def u(self):
-        return None if self.stokes is None else self.stokes[2] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
-
-    q_err = None
-    u_err = None
-
-    @property
-    def geometry(self) -> Geometry:
-        if not hasattr(self, "_geometry"):
-            self._geometry = Geometry(self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
-        return self._geometry
-
-    @property
-    def observables(self) -> list[str]:
-        names = [n for n in ("dop", "brdf", "aop") if getattr(self, n) is not None]
-        if self.stokes is not None:
-            names.append("stokes")
-        if self.mueller is not None:
-            names.append("mueller")
-        return names
-
-    def select(self, mask) -> "Dataset":
-        """A subset of the rows (boolean mask or indices)."""
-        idx = np.arange(len(self))[mask]
-        changes = {}
-        for name in ("theta_i", "theta_r", "dphi", "wavelength_um", "dop", "dop_err", "brdf", "brdf_err", "aop", "aop_err"):
-            value = getattr(self, name)
-            changes[name] = None if value is None else value[idx]
-        changes["stokes"] = None if self.stokes is None else self.stokes[:, idx]
-        changes["mueller"] = None if self.mueller is None else self.mueller[:, :, idx]
-        changes["mueller_err"] = None if self.mueller_err is None else self.mueller_err[:, :, idx]
-        return replace(self, **changes)
-
-    def in_plane(self, tolerance_deg: float = 1e-6) -> "Dataset":
-        """Rows in the plane of incidence: dphi = 0 (retro side) or 180 deg (specular side)."""
-        off = np.abs(np.sin(np.radians(self.dphi)))
-        return self.select(off < np.sin(np.radians(tolerance_deg)) + 1e-12)
-
-    def at_wavelengths(self, wavelengths_um, tolerance_um: float = 1e-4) -> "Dataset":
-        """The rows at any of ``wavelengths_um`` (each must be present)."""
-        keep = np.zeros(len(self), bool)
-        for w in wavelengths_um:
-            keep |= self._rows_at(w, tolerance_um)
-        return self.select(keep)
-
-    def _rows_at(self, wavelength_um: float, tolerance_um: float):
-        """Boolean mask of the rows at ``wavelength_um``; absent -> one line naming the wavelengths there are."""
-        if self.wavelength_um is None:
-            raise InputFileError(self.source, "has no wavelength to select on")
-        keep = np.abs(self.wavelength_um - wavelength_um) < tolerance_um
-        if not keep.any():
-            have = ", ".join(f"{w:g}" for w in np.unique(self.wavelength_um))
-            raise InputFileError(self.source, f"no rows at wavelength {wavelength_um:g} um (have {have})")
-        return keep
-
-    def at_wavelength(self, wavelength_um: float, tolerance_um: float = 1e-4) -> "Dataset":
-        out = self.select(self._rows_at(wavelength_um, tolerance_um))
-        out.metadata = {**self.metadata, "wavelength_um": wavelength_um}
-        return out
-
+__all__ = ["Dataset", "GEOMETRY_COLUMNS", "KNOWN_COLUMNS", "MUELLER_COLUMNS", "OBSERVABLE_COLUMNS", "read_measurements",
+           "write_table"]
 
 def _parse_metadata(lines, path):
     meta, first_data = {}, 0
@@ -137,17 +44,6 @@ def _parse_metadata(lines, path):
     return meta, first_data
 
 
-def _number(text, path, line, column):
-    try:
-        value = float(text)
-    except ValueError:
-        shown = text if text.strip() else "(empty)"
-        raise InputFileError(path, f"'{shown}' is not a number", line=line, column=column) from None
-    if not np.isfinite(value):
-        raise InputFileError(path, f"'{text}' is not a finite number", line=line, column=column)
-    return value
-
-
 def read_measurements(path, require_observable: bool = True) -> Dataset:
     """Read a spacepol CSV or a NIST Mueller BRDF file."""
     path = Path(path)
@@ -165,8 +61,6 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
         raise InputFileError(path, "empty file: no header row")
     header_line = skip + 1
     header = [h.strip() for h in next(csv.reader([lines[skip]]))]
-
-    from .nist import is_nist_header, read_nist_rows
 
     if is_nist_header(header):
         return read_nist_rows(path, header, lines[skip + 1 :], header_line, meta)
@@ -204,7 +98,7 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
             raise InputFileError(path, f"{len(row)} fields, header has {len(header)}", line=line)
         values = {}
         for column, cell in zip(header, row):
-            values[column] = _number(cell.strip(), path, line, column)
+            values[column] = parse_number(cell.strip(), path, line, column)
             _check_value(values[column], column, path, line)
             columns[column].append(values[column])
         if "s0" in values:
@@ -218,7 +112,7 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     n = len(arrays["theta_i"])
     wavelength = arrays.get("wavelength_um")
     if wavelength is None and "wavelength_um" in meta:
-        wl = _number(meta["wavelength_um"], path, None, "wavelength_um metadata")
+        wl = parse_number(meta["wavelength_um"], path, None, "wavelength_um metadata")
         if wl <= 0:
             raise InputFileError(path, f"metadata wavelength_um {wl:g} um must be positive")
         wavelength = np.full(n, wl)
@@ -246,12 +140,6 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     )
 
 
-def is_blank_row(row: list[str]) -> bool:
-    """Whether a parsed CSV row is a blank line (no separator, at most whitespace): skipped. A row of separators
-    alone is not blank: its fields are empty, which is an error."""
-    return len(row) <= 1 and all(not cell.strip() for cell in row)
-
-
 def _check_mueller_header(header, path, line):
     """All 15 normalised elements or none; errors as m_err, or per element for all 15."""
     given = [m for m in MUELLER_COLUMNS if m in header]
@@ -265,18 +153,6 @@ def _check_mueller_header(header, path, line):
         missing = [f"{m}_err" for m in MUELLER_COLUMNS if f"{m}_err" not in header]
         raise InputFileError(path, f"per-element Mueller errors need all 15 columns (or one m_err for the rest); "
                                    f"missing {', '.join(missing)}", line=line)
-
-
-def check_mueller_element(value, path, line, column):
-    if abs(value) > 1:
-        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
-
-
-def check_first_column(m21, m31, m41, path, line, column):
-    """The state unpolarized light leaves in (m21, m31, m41): its degree of polarization cannot exceed 1."""
-    dop = float(np.sqrt(m21**2 + m31**2 + m41**2))
-    if dop > 1:
-        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line, column=column)
 
 
 def _mueller(arrays, n):

@@ -16,6 +16,8 @@ import io as _io
 import numpy as np
 
 from ..errors import InputFileError
+from .cells import check_first_column, check_mueller_element, is_blank_row, parse_number
+from .dataset import Dataset
 
 _RATIO_NAMES = [f"m{i}{j}" for i in range(1, 5) for j in range(1, 5)][1:]
 
@@ -30,7 +32,6 @@ def _wrap_deg(angle):
 
 
 def read_nist_rows(path, header, lines, header_line, meta):
-    from .measurements import Dataset, _number, check_first_column, check_mueller_element, is_blank_row
 
     if len(header) != 21:
         raise InputFileError(path, f"NIST Mueller layout needs 21 columns, header has {len(header)}", line=header_line)
@@ -44,7 +45,7 @@ def read_nist_rows(path, header, lines, header_line, meta):
             raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         if len(row) != 21:
             raise InputFileError(path, f"{len(row)} fields, header has 21", line=line)
-        values = [_number(c.strip(), path, line, header[i]) for i, c in enumerate(row)]
+        values = [parse_number(c.strip(), path, line, header[i]) for i, c in enumerate(row)]
         for col in (1, 3):
             if abs(values[col]) >= 90:
                 raise InputFileError(path, f"angle {values[col]:g} deg: |angle| must be below 90", line=line, column=header[col])

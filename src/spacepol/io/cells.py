@@ -1,0 +1,39 @@
+"""Checks of single cells and rows of a measurement file, shared by the spacepol CSV reader and NIST's layout: each
+problem is one :class:`InputFileError` naming file, line and column."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputFileError
+
+
+def parse_number(text, path, line, column) -> float:
+    """The cell's finite number, or an error naming where it is."""
+    try:
+        value = float(text)
+    except ValueError:
+        shown = text if text.strip() else "(empty)"
+        raise InputFileError(path, f"'{shown}' is not a number", line=line, column=column) from None
+    if not np.isfinite(value):
+        raise InputFileError(path, f"'{text}' is not a finite number", line=line, column=column)
+    return value
+
+
+def is_blank_row(row: list[str]) -> bool:
+    """Whether a parsed CSV row is a blank line (no separator, at most whitespace): skipped. A row of separators
+    alone is not blank: its fields are empty, which is an error."""
+    return len(row) <= 1 and all(not cell.strip() for cell in row)
+
+
+def check_mueller_element(value, path, line, column):
+    """A normalised Mueller element M_ij / M_11 lies in [-1, 1]."""
+    if abs(value) > 1:
+        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
+
+
+def check_first_column(m21, m31, m41, path, line, column):
+    """The state unpolarized light leaves in (m21, m31, m41): its degree of polarization cannot exceed 1."""
+    dop = float(np.sqrt(m21**2 + m31**2 + m41**2))
+    if dop > 1:
+        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line, column=column)

@@ -108,3 +108,33 @@ def test_the_approximation_is_refused_on_the_dop_ridge():
     sample = laplace_importance(post, centre, np.random.default_rng(1))
     assert sample is None or not sample.reliable
     assert invert_laplace(post, centre, seed=1) is None
+
+
+def _ptfe_ridge_set():
+    """PTFE at 0.633 um, every 6th geometry and every reciprocal pair (the diagnose speed benchmark's 278 rows)."""
+    from spacepol.infer.measured_noise import reciprocal_pairs
+
+    first = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
+    rows = np.union1d(np.arange(0, len(first), max(1, len(first) // 260)), reciprocal_pairs(first).ravel())
+    return first.select(rows)
+
+
+def test_weights_collapsed_onto_the_mode_of_a_ridge_are_refused():
+    """PTFE under paper + lambertian + oxide_layer: n, k and the film thickness trade along a curved ridge. The adapted
+    proposal shrinks onto the mode: its Pareto k and effective draws pass (the old gate would trust it), but the
+    weighted SD of n in the sampling space is about half the Laplace SD there, so it is refused. Control: ``paper`` on
+    the same data, where the approximation holds, keeps every coordinate's width (ratio >= 0.9)."""
+    from spacepol.infer.laplace import MIN_WIDTH_RATIO
+    from spacepol.infer.optimum import multistart
+
+    data = _ptfe_ridge_set()
+    ridge = Posterior.build(data, Model.from_string("paper+lambertian+oxide_layer"))
+    _, centre = multistart(ridge, np.random.default_rng(0))
+    sample = laplace_importance(ridge, centre, np.random.default_rng(2))
+    assert sample is not None and not sample.reliable
+    assert sample.pareto_k <= 0.7 and sample.effective_draws >= 400, (sample.pareto_k, sample.effective_draws)
+    assert sample.width_ratio < 0.6 < MIN_WIDTH_RATIO, sample.width_ratio
+    control = Posterior.build(data, Model.from_string("paper"))
+    _, centre = multistart(control, np.random.default_rng(0))
+    kept = laplace_importance(control, centre, np.random.default_rng(0))
+    assert kept is not None and kept.reliable and kept.width_ratio >= 0.9, (kept.pareto_k, kept.width_ratio)

@@ -184,3 +184,21 @@ def test_refits_asked_for_are_skipped_only_where_the_optima_already_decide(monke
     refit = control["remove polarized_diffuse"]
     assert refit["significant"] is False and refit["delta_elpd"] < -2 * refit["delta_elpd_se"] and refit["delta_elpd"] < -4
     assert control["replace shadowing by smith"]["delta_elpd"] is not None
+
+
+def test_a_refit_whose_chain_did_not_converge_is_said_so():
+    """``posterior_quality``: trusted importance weights, a converged chain, and (the case diagnose must not hide) a
+    chain stopped by its cap before R-hat and ESS reached their targets."""
+    from types import SimpleNamespace
+
+    from spacepol.criticism.diagnose import posterior_quality
+
+    def fit(engine, rhat=None, ess=None, steps=None):
+        return SimpleNamespace(summary={"diagnostics": {"engine": engine, "rhat_max": rhat, "ess_min": ess, "pareto_k": 0.4}},
+                               result=SimpleNamespace(info={"steps": steps}))
+
+    assert posterior_quality(fit("laplace-is", None, 900.0))["converged"]
+    assert posterior_quality(fit(None, 1.004, 650.0, 4000))["converged"]
+    stuck = posterior_quality(fit(None, 1.13, 147.0, 8000))
+    assert not stuck["converged"] and stuck["steps"] == 8000 and stuck["engine"] == "emcee"
+    assert not posterior_quality(fit(None, 1.005, 120.0, 8000))["converged"]  # R-hat alone is not enough

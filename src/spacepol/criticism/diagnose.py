@@ -154,7 +154,9 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         fit_start = time.perf_counter()
         inv = fit_for_elpd(c["posterior"], c["optimum"], seed, max_steps, posterior_method)
         if progress and posterior_method == "laplace" and inv.summary["diagnostics"].get("engine") != "laplace-is":
-            _say(f"  the Laplace approximation was not trusted there: emcee took {time.perf_counter() - fit_start:.0f} s")
+            q = posterior_quality(inv)
+            _say(f"  the Laplace approximation was not trusted there: emcee took {time.perf_counter() - fit_start:.0f} s"
+                 + ("" if q["converged"] else f" and did not converge (R-hat {q['rhat_max']:.3f}, ESS {q['ess_min']:.0f})"))
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
@@ -176,6 +178,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["explains_misfit"] = not _structured(c["inversion"].summary)
         entry["screening_gain"] = c["screening_gain"]
         entry["explanation"] = _explain(c, base)
+        entry["posterior"] = posterior_quality(c["inversion"])
+        if not entry["posterior"]["converged"]:
+            q = entry["posterior"]
+            entry["explanation"] += (f" Its posterior did not converge ({q['steps']} emcee steps, R-hat {q['rhat_max']:.3f}, "
+                                     f"ESS {q['ess_min']:.0f}): its delta ELPD-LOO is less certain than its SE says.")
         ranking.append(entry)
     for c in [c for c in screened if c not in to_confirm]:
         entry = {"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
@@ -203,7 +210,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                                               f"two are twins here; {sep} would separate them.")
     for entry, c in zip(ranking, confirmed):
         entry["free_parameters"] = c["posterior"].ndim
-    return {"model": model.name, "fit": base.summary["fit"], "ranking": ranking, "verdict": verdict,
+    return {"model": model.name, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
+            "ranking": ranking, "verdict": verdict,
             "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
@@ -241,6 +249,22 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
             return inv
     return invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
                   tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
+
+
+def posterior_quality(inv) -> dict:
+    """How a refit's posterior was obtained and whether it can be trusted: the engine (laplace-is: trusted weights by
+    construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for, else not converged within its cap)."""
+    d = inv.summary["diagnostics"]
+    engine = d.get("engine") or "emcee"
+    if engine == "laplace-is":
+        return {"engine": engine, "converged": True, "pareto_k": d.get("pareto_k"), "effective_draws": d.get("ess_min")}
+    rhat, ess = d.get("rhat_max"), d.get("ess_min")
+    converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET
+    return {"engine": engine, "converged": bool(converged), "rhat_max": rhat, "ess_min": ess,
+            "steps": inv.result.info.get("steps")}
+
+
+RHAT_TARGET, ESS_TARGET = 1.01, 400.0  # as emcee's run waits for (``engines.emcee_sampler``)
 
 
 # the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it

@@ -100,11 +100,11 @@ def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     # and the residuals say the misfit is smooth: the BRDF's U shape (the body term's cos(theta_r))
     assert s["residual_structure"]["runs"]["brdf"]["p"] < 0.01
     assert "model that is wrong" in (out / "report.html").read_text()
-    # the diffuse weight piles against its prior bound 1 (a Lambertian-like PTFE asks for more than the
+    # the diffuse weight piles against its bound 1, a reflectance's limit (a Lambertian-like PTFE asks for more than the
     # paper's cos(theta_r) body term gives): flagged, and never called well constrained (issue 9)
     flags = s["identifiability"]["at_bound"]
     assert any(f["parameter"] == "rho_d" and f["side"] == "upper" for f in flags), flags
-    assert "rho_d sits at its upper bound 1" in (out / "report.html").read_text()
+    assert "rho_d reaches its physical limit 1" in (out / "report.html").read_text()  # a reflectance of 1
     assert not any("well constrained" in f for f in s["identifiability"]["findings"])
 
 

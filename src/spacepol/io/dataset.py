@@ -6,6 +6,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InputFileError
 from ..physics.geometry import Geometry
 
 GEOMETRY_COLUMNS = ("theta_i", "theta_r", "dphi", "wavelength_um")

@@ -39,6 +39,9 @@ def make_sets(folder: Path, count: int) -> Path:
 
 
 def main():
+    from spacepol import configure_process
+
+    configure_process()  # the settings the command line makes
     parser = argparse.ArgumentParser()
     parser.add_argument("--sets", type=int, default=6)
     args = parser.parse_args()

@@ -26,9 +26,9 @@ TARGETS_S = {1: 300.0, 2: 600.0}
 
 
 def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress: bool = False) -> None:
-    from spacepol._runtime import inline_small_calls
+    from spacepol import configure_process
 
-    inline_small_calls()
+    configure_process(small_calls=True)  # as the command line runs
     from spacepol.criticism.rounds import diagnose_rounds
     from spacepol.infer.measured_noise import reciprocal_pairs
     from spacepol.io import read_measurements

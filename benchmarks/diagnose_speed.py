@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from spacepol._runtime import inline_small_calls
+from spacepol import configure_process
 from spacepol.criticism.diagnose import diagnose
 from spacepol.io import read_measurements
 from spacepol.paths import bundled
@@ -24,7 +24,7 @@ from spacepol.physics import Model
 
 
 def main():
-    inline_small_calls()  # as the command line runs: small calls on the calling thread
+    configure_process(small_calls=True)  # as the command line runs: small calls on the calling thread
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()

@@ -210,6 +210,9 @@ def up_to_scale_versus_divided(model, sets, geometry, repeats):
 
 
 def main():
+    from spacepol import configure_process
+
+    configure_process()  # the settings the command line makes
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer repeats, no 64 x 100,000 case")
     args = parser.parse_args()

@@ -30,6 +30,9 @@ from spacepol.report.criticism_figures import validation_figure
 
 
 def main():
+    from spacepol import configure_process
+
+    configure_process()  # the settings the command line makes
     ap = argparse.ArgumentParser()
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default="reports/validation")

@@ -25,10 +25,9 @@ import time
 
 import numpy as np
 
-from spacepol._runtime import configure_jax, inline_small_calls
+from spacepol import configure_process
 
-configure_jax()
-inline_small_calls()  # as the command line runs: small calls on the calling thread
+configure_process(small_calls=True)  # as the command line runs
 
 from spacepol.infer.engines import optimize  # noqa: E402
 from spacepol.infer.engines.nuts import sample_nuts  # noqa: E402

@@ -25,9 +25,9 @@ def main():
     ap.add_argument("--size", type=int, default=260)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    from spacepol._runtime import inline_small_calls
+    from spacepol import configure_process
 
-    inline_small_calls()
+    configure_process(small_calls=True)  # as the command line runs
     from spacepol.criticism.diagnose import ELPD_DRAWS, ELPD_TAU_MULTIPLE
     from spacepol.infer.inversion import invert, invert_laplace
     from spacepol.infer.measured_noise import reciprocal_pairs

@@ -23,10 +23,9 @@ import time
 
 import numpy as np
 
-from spacepol._runtime import configure_jax, inline_small_calls
+from spacepol import configure_process
 
-configure_jax()
-inline_small_calls()  # as the command line runs: small calls on the calling thread
+configure_process(small_calls=True)  # as the command line runs
 
 from spacepol.infer.engines.de import run_de  # noqa: E402
 from spacepol.infer.objective import NegativeLogPosterior  # noqa: E402

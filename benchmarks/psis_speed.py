@@ -19,6 +19,9 @@ from spacepol.infer.psis import psis_log_weights
 
 
 def main():
+    from spacepol import configure_process
+
+    configure_process()  # the settings the command line makes
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()

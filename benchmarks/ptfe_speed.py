@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spacepol._runtime import inline_small_calls
+from spacepol import configure_process
 from spacepol.infer.inversion import invert
 from spacepol.infer.posterior import Posterior
 from spacepol.io import read_measurements
@@ -61,7 +61,7 @@ def per_call(posterior: Posterior, repeats: int = 15) -> tuple[float, float]:
 
 
 def main():
-    inline_small_calls()  # as the command line runs: small calls on the calling thread
+    configure_process(small_calls=True)  # as the command line runs: small calls on the calling thread
     parser = argparse.ArgumentParser()
     parser.add_argument("--wavelengths", nargs="+", default=["0.633", "all"])
     parser.add_argument("--seed", type=int, default=0)

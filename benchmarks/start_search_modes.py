@@ -18,7 +18,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from spacepol._runtime import inline_small_calls
+from spacepol import configure_process
 
 
 def main() -> None:
@@ -28,7 +28,7 @@ def main() -> None:
     parser.add_argument("--model", default="paper+polarized_diffuse")
     parser.add_argument("--evaluations", type=int, default=3000)  # what search_modes gives each search
     args = parser.parse_args()
-    inline_small_calls()
+    configure_process(small_calls=True)
     from spacepol.commands import model_for
     from spacepol.infer.modes import SAME_MODE_LOG_POSTERIOR
     from spacepol.infer.optimum import find_optimum, find_optimum_profiled

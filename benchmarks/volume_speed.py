@@ -37,6 +37,9 @@ def _median_seconds(call, repeats: int) -> float:
 
 
 def main() -> None:
+    from spacepol import configure_process
+
+    configure_process()  # the settings the command line makes
     from pySCATMECH.brdf import BRDF_Model
 
     from spacepol.physics import Geometry, Model

@@ -287,6 +287,9 @@ def write_report(out: Path, meta: dict, rungs: list[dict], data_recip: dict, don
 
 
 def main(argv=None) -> int:
+    from spacepol import configure_process
+
+    configure_process(small_calls=True)  # the settings the command line makes
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--wavelength-um", default="all")
     parser.add_argument("--rounds", type=int, default=3)

@@ -81,6 +81,7 @@ def heap_kept_bytes() -> int:
 
 
 def keep_heap() -> None:
+    """glibc's heap keeps freed memory (the module's second paragraph); an explicit MALLOC_* variable is kept."""
     if not sys.platform.startswith("linux") or any(v in os.environ for v in _HEAP_VARIABLES):
         return
     try:
@@ -97,6 +98,7 @@ _VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
 
 
 def limit_blas_threads() -> None:
+    """One BLAS thread unless the environment names a count (the module's first paragraph)."""
     if any(v in os.environ for v in _VARIABLES):
         return
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
@@ -112,6 +114,7 @@ _WIDE_VECTORS = "--xla_cpu_prefer_vector_width=512"
 
 
 def has_avx512() -> bool:
+    """Whether the CPU has AVX-512 (from /proc/cpuinfo; False elsewhere)."""
     try:
         with open("/proc/cpuinfo") as cpuinfo:
             return any(line.startswith("flags") and " avx512f" in line for line in cpuinfo)
@@ -120,6 +123,7 @@ def has_avx512() -> bool:
 
 
 def prefer_wide_vectors() -> None:
+    """512-bit vectors for XLA on an AVX-512 CPU, unless XLA_FLAGS already names the option."""
     flags = os.environ.get("XLA_FLAGS", "")
     if "xla_cpu_prefer_vector_width" in flags or not has_avx512():
         return
@@ -140,7 +144,30 @@ def inline_small_calls() -> None:
     jax.config.update("jax_cpu_enable_async_dispatch", False)
 
 
+def configure_process(small_calls: bool = False) -> None:
+    """Every process-wide setting of this module, in one call, for the processes that opt in (the command line,
+    batch workers, benchmarks, the test suite): one BLAS thread, the heap kept, JAX in double precision with wide
+    vectors and its compiled programs kept on disk, and with ``small_calls`` compiled programs run on the calling
+    thread. ``import spacepol`` calls none of them; a library user who wants the same speed calls this first."""
+    limit_blas_threads()
+    keep_heap()
+    configure_jax()
+    if small_calls:
+        inline_small_calls()
+
+
+def ensure_double_precision() -> None:
+    """JAX in double precision, turned on where spacepol first builds a model or a compiled program (not at import):
+    the forward model's polarization near the specular peak and nearly index-matched Fresnel reflectances are wrong
+    in float32, which is JAX's default. A no-op once it is on."""
+    import jax
+
+    if not jax.config.jax_enable_x64:
+        jax.config.update("jax_enable_x64", True)
+
+
 def configure_jax() -> None:
+    """Wide vectors where the CPU has them, double precision, and compiled programs kept on disk."""
     prefer_wide_vectors()  # before JAX creates its CPU backend, which reads XLA_FLAGS once
     import jax
 

@@ -189,11 +189,13 @@ def main(argv=None) -> int:
         warnings.filterwarnings("ignore", category=FutureWarning)
         warnings.filterwarnings("ignore", category=DeprecationWarning)
         warnings.filterwarnings("ignore", module=r"jax\..*")  # e.g. an unreadable entry of the compilation cache
-    from . import commands
-    from ._runtime import inline_small_calls
-    from .errors import SpacepolError
+    from ._runtime import configure_process
 
-    inline_small_calls()  # before the first computation: a command's many small calls (samplers, optimizers)
+    # before numpy's BLAS and JAX's backend start: the speed settings, and a command's many small calls (samplers,
+    # optimizers) on the calling thread
+    configure_process(small_calls=True)
+    from . import commands
+    from .errors import SpacepolError
 
     try:
         for spec in args.effect + getattr(args, "effect_after", []):

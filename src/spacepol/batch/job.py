@@ -21,11 +21,11 @@ SETTINGS_FILE = "batch_settings.json"
 
 def run_job(job: BatchJob, out: str) -> dict:
     """Invert one set into ``out/<id>/``; the results row ``{id, status, seconds, error, summary}``."""
-    from .._runtime import inline_small_calls
+    from .._runtime import configure_process
     from ..cli import _wavelengths
     from ..errors import SpacepolError
 
-    inline_small_calls()  # a fresh worker (Dask's) before its first computation; elsewhere a no-op
+    configure_process(small_calls=True)  # a fresh worker (Dask's) before its first computation; elsewhere a no-op
 
     folder = Path(out) / job.id
     start = time.perf_counter()

@@ -31,6 +31,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._runtime import ensure_double_precision
 from .prior_set import PriorSet
 
 _U_FLOOR = 1e-15  # a parameter exactly at a bound maps to a finite z (|z| <= 34.5)
@@ -63,6 +64,7 @@ class SamplingSpace:
     family = "logit-cdf"
 
     def __init__(self, priors: PriorSet, declared=()):
+        ensure_double_precision()  # its transforms are JAX code, wrong in float32 near the bounds
         self.priors = priors
         self.names = priors.names
         unknown = set(declared) - set(self.names)

@@ -32,6 +32,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._runtime import ensure_double_precision
 from .arrays import array_module
 from .builtin_effects import Specular
 from .effect import Context, DepolarizedLobe, Effect, Ratio
@@ -185,6 +186,7 @@ def jitted(effects, names: tuple, fixed: dict, mueller: bool, all_visible: bool,
     ``-> (dop,)`` with ``dop_only`` (the Stokes vector then stays inside the fused program: for the paper's DOP,
     4 x 4,096 x 84, writing it out cost 40 % of the evaluation); ``fixed`` values (parameters nobody set) are compiled
     in as constants; ``names``: the traced parameters, in the packed columns' order."""
+    ensure_double_precision()
     key = (tuple(e if is_plugin(e) else type(e) for e in effects), names, mueller, tuple(sorted(fixed.items())),
            all_visible, dop_only)
     if key not in _JITTED:
@@ -205,6 +207,7 @@ class Program:
     callers that use nothing but ratios of its elements."""
 
     def __init__(self, model, geometry: Geometry, mueller: bool, up_to_scale: bool = False):
+        ensure_double_precision()
         inner = model.inner
         self.effects, self.defaults, self.mueller, self.up_to_scale = inner.effects, inner.defaults(), mueller, up_to_scale
         self.parts = model.parts(geometry)  # [(rows, sub-geometry, values -> the inner model's values)]

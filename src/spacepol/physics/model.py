@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import jax.numpy as jnp
 import numpy as np
 
+from .._runtime import ensure_double_precision
 from ..errors import ParameterError, SpacepolError, UnknownNameError
 from .arrays import array_module
 from .compiled import degree_of_polarization, evaluate_values, jitted, packed
@@ -73,6 +74,7 @@ class Model:
     DESIGN.md's names, ``parameters`` lists its parameters with their default priors."""
 
     def __init__(self, effects):
+        ensure_double_precision()  # the physics is wrong in float32, JAX's default
         self.effects: list[Effect] = [self._instance(e) for e in effects]
         self._check()
 

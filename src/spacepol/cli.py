@@ -181,6 +181,8 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """``invert-mcmc``: parse ``argv`` (default sys.argv), opt in to the process settings, run the command; a
+    SpacepolError becomes one line on stderr and exit status 2. Returns the exit status."""
     args = _parser().parse_args(argv)
     import os
     import warnings

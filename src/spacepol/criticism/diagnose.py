@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
+from ..infer.engines.emcee_sampler import ESS_TARGET, RHAT_TARGET
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
 from ..infer.inversion import explains, invert, invert_laplace
@@ -156,7 +157,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         if progress and posterior_method == "laplace" and inv.summary["diagnostics"].get("engine") != "laplace-is":
             q = posterior_quality(inv)
             _say(f"  the Laplace approximation was not trusted there: emcee took {time.perf_counter() - fit_start:.0f} s"
-                 + ("" if q["converged"] else f" and did not converge (R-hat {q['rhat_max']:.3f}, ESS {q['ess_min']:.0f})"))
+                 + ("" if q["converged"] else f" and {_unconverged(q)}"))
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
@@ -180,9 +181,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["explanation"] = _explain(c, base)
         entry["posterior"] = posterior_quality(c["inversion"])
         if not entry["posterior"]["converged"]:
-            q = entry["posterior"]
-            entry["explanation"] += (f" Its posterior did not converge ({q['steps']} emcee steps, R-hat {q['rhat_max']:.3f}, "
-                                     f"ESS {q['ess_min']:.0f}): its delta ELPD-LOO is less certain than its SE says.")
+            entry["explanation"] += (f" Its posterior {_unconverged(entry['posterior'])}: its delta ELPD-LOO is less "
+                                     "certain than its SE says.")
         ranking.append(entry)
     for c in [c for c in screened if c not in to_confirm]:
         entry = {"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
@@ -264,7 +264,10 @@ def posterior_quality(inv) -> dict:
             "steps": inv.result.info.get("steps")}
 
 
-RHAT_TARGET, ESS_TARGET = 1.01, 400.0  # as emcee's run waits for (``engines.emcee_sampler``)
+def _unconverged(quality: dict) -> str:
+    """``posterior_quality``'s figures for a chain that stopped short of its targets, in words."""
+    return (f"did not converge ({quality['steps']} emcee steps, R-hat {quality['rhat_max']:.3f}, "
+            f"ESS {quality['ess_min']:.0f})")
 
 
 # the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it

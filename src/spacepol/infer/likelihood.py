@@ -22,7 +22,6 @@ import numpy as np
 from scipy.special import gammaln
 
 from .. import observables as obs
-from .._runtime import ensure_double_precision
 from ..errors import ParameterError
 from ..io.measurements import Dataset
 from ..physics.arrays import array_module
@@ -88,7 +87,6 @@ class Likelihood:
     out (``left_out``), so no measured number counts twice. Evaluated for many parameter rows at once."""
 
     def __init__(self, data: Dataset, model: Model, observables=None, robust: bool = False, nu: float = 4.0):
-        ensure_double_precision()  # a model built elsewhere (a plug-in's own class) may not have turned it on
         self.data, self.model = data, model
         # left_out: observables in the data not fitted because a fitted one holds their numbers
         self.objects, self.left_out = select_observables(data, observables)

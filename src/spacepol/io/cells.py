@@ -20,10 +20,14 @@ def parse_number(text, path, line, column) -> float:
     return value
 
 
-def is_blank_row(row: list[str]) -> bool:
-    """Whether a parsed CSV row is a blank line (no separator, at most whitespace): skipped. A row of separators
-    alone is not blank: its fields are empty, which is an error."""
-    return len(row) <= 1 and all(not cell.strip() for cell in row)
+def is_blank_row(row: list[str], path, line) -> bool:
+    """Whether a parsed CSV row is a blank line (no separator, at most whitespace), which readers skip. A row of
+    separators alone is not blank: its fields are empty, an error naming the line."""
+    if all(not cell.strip() for cell in row):
+        if len(row) > 1:
+            raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
+        return True
+    return False
 
 
 def check_mueller_element(value, path, line, column):

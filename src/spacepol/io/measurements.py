@@ -90,10 +90,8 @@ def read_measurements(path, require_observable: bool = True) -> Dataset:
     reader = csv.reader(_io.StringIO("\n".join(lines[skip + 1 :])))
     for offset, row in enumerate(reader, start=1):
         line = header_line + offset
-        if is_blank_row(row):
+        if is_blank_row(row, path, line):
             continue
-        if all(not cell.strip() for cell in row):
-            raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         if len(row) != len(header):
             raise InputFileError(path, f"{len(row)} fields, header has {len(header)}", line=line)
         values = {}

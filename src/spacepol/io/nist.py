@@ -39,10 +39,8 @@ def read_nist_rows(path, header, lines, header_line, meta):
     rows = []
     for offset, row in enumerate(csv.reader(_io.StringIO("\n".join(lines))), start=1):
         line = header_line + offset
-        if is_blank_row(row):
+        if is_blank_row(row, path, line):
             continue
-        if all(not c.strip() for c in row):
-            raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         if len(row) != 21:
             raise InputFileError(path, f"{len(row)} fields, header has 21", line=line)
         values = [parse_number(c.strip(), path, line, header[i]) for i, c in enumerate(row)]

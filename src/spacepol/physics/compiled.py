@@ -186,7 +186,6 @@ def jitted(effects, names: tuple, fixed: dict, mueller: bool, all_visible: bool,
     ``-> (dop,)`` with ``dop_only`` (the Stokes vector then stays inside the fused program: for the paper's DOP,
     4 x 4,096 x 84, writing it out cost 40 % of the evaluation); ``fixed`` values (parameters nobody set) are compiled
     in as constants; ``names``: the traced parameters, in the packed columns' order."""
-    ensure_double_precision()
     key = (tuple(e if is_plugin(e) else type(e) for e in effects), names, mueller, tuple(sorted(fixed.items())),
            all_visible, dop_only)
     if key not in _JITTED:

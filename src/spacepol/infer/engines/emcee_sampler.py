@@ -105,6 +105,10 @@ def _rhat_ess(sampler, tau, space):
     return worst_rhat_ess(chain.transpose(1, 0, 2))
 
 
+RHAT_TARGET = 1.01  # a run waits for ArviZ's rank-normalised split R-hat at most this
+ESS_TARGET = 400.0  # and bulk and tail ESS at least this
+
+
 def starting_points(posterior, rng, count: int, initial=None):
     """((count, D) starting parameter vectors, the ModeSearch behind them or None): ``initial`` as given, prior
     draws for "prior", or by default a small ball around the best mode of the start-point searches."""
@@ -145,7 +149,7 @@ def _tau_at(sampler, iteration: int, space) -> np.ndarray:
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
                  tau_multiple: float = 50.0, check_every: int = 500, min_steps: int = 1000,
                  backend_path=None, progress: bool = True, model_name: str = "", seed: int | None = None,
-                 initial=None, rhat_target: float = 1.01, ess_target: float = 400.0, space=None) -> Result:
+                 initial=None, rhat_target: float = RHAT_TARGET, ess_target: float = ESS_TARGET, space=None) -> Result:
     """``space``: the coordinates the walkers move in (default ``SamplingSpace``, the logit of each prior's CDF;
     ``DeclaredSpace`` is the declared parameters, the baseline of ``benchmarks/inversion_speed.py``)."""
     from ..chain_file import chain_iterations, random_state_readable, replace_random_state

@@ -26,6 +26,7 @@ import numpy as np
 from ..differentiable import log_likelihood_function
 from ..result import Result
 from ..sampling_space import SamplingSpace
+from .emcee_sampler import ESS_TARGET, RHAT_TARGET
 
 
 def _potential(posterior, space):
@@ -47,8 +48,8 @@ def _block(mcmc, fields):
 
 def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: int = 500, draws: int = 500,
                 max_draws: int = 8000, target_accept: float = 0.8, initial=None, progress: bool = True,
-                model_name: str = "", seed: int | None = None, rhat_target: float = 1.01,
-                ess_target: float = 400.0, space=None) -> Result:
+                model_name: str = "", seed: int | None = None, rhat_target: float = RHAT_TARGET,
+                ess_target: float = ESS_TARGET, space=None) -> Result:
     """``space``: the coordinates the chains move in (default: the logit space, every parameter)."""
     from numpyro.infer import MCMC, NUTS
 

@@ -85,7 +85,7 @@ def element_rms(inv) -> dict:
     from spacepol.infer.inference_data import median_fit
 
     lik = inv.posterior.likelihood
-    mu, _ = median_fit(inv.posterior, inv.result.flat_samples())
+    mu, _ = median_fit(inv.posterior, inv.draws.flat_samples())
     return {ch: float(np.sqrt(np.mean(np.square(lik.residual(ch, mu[ch]))))) for ch in lik.observables}
 
 
@@ -334,7 +334,7 @@ def main(argv=None) -> int:
             base = fits[1]["_inversion"]
             current = base.posterior.likelihood.model
         final = base or fits[0]["_inversion"]
-        save_figure(mueller_residual_figure(final.posterior, final.result), out / "final_residuals_mueller.png")
+        save_figure(mueller_residual_figure(final.posterior, final.draws), out / "final_residuals_mueller.png")
         meta = {"data": "NIST sintered PTFE Mueller BRDF (Germer 2017)", "arguments": " ".join(argv or sys.argv[1:]),
                 "minutes": (time.perf_counter() - start) / 60, "machine": "2 cores", "rows": len(data),
                 "observables": observables, "numbers": len(data) * len(observables),

@@ -11,7 +11,7 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 import pytest
 
-from spacepol.sky.sun import sun_position
+from spacepol.skylight.sun import sun_position
 from test_contrast import _run_dir
 
 TODAY = datetime.now(timezone.utc).replace(hour=4, minute=0, second=0, microsecond=0)

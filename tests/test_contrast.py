@@ -55,8 +55,8 @@ def test_contrast_of_a_point_posterior_is_exact(tmp_path):
 def test_sky_spread_follows_p_max_and_dominance_is_named(tmp_path):
     """P_max ~ U(0.6, 0.8): the sky DOP's 5 and 95 % points are the sky's unit DOP times 0.61 and 0.79 (Monte-Carlo
     error of a 5 % quantile from 20000 draws: ~0.002 relative)."""
-    from spacepol.sky.rayleigh import RayleighSky
-    from spacepol.sky.sun import sun_position
+    from spacepol.skylight.rayleigh import RayleighSky
+    from spacepol.skylight.sun import sun_position
 
     run = _run_dir(tmp_path, spread=1.0)
     scenario = tmp_path / "s.toml"
@@ -126,9 +126,10 @@ def _scenario(tmp_path, wavelength):
 def _target_dop(tmp_path, run, wavelength, extrapolate=False):
     """contrast.json of the run at the scenario's wavelength, through the library (the command line is the
     same call: test_contrast_of_a_point_posterior_is_exact)."""
+    from spacepol.infer.result import Result
     from spacepol.report.contrast_report import make_contrast_report
 
-    return make_contrast_report(run, read_scenario(_scenario(tmp_path, wavelength)), tmp_path / f"c{wavelength}{extrapolate}",
+    return make_contrast_report(Result.load(run), read_scenario(_scenario(tmp_path, wavelength)), tmp_path / f"c{wavelength}{extrapolate}",
                                 draws=200, extrapolate=extrapolate)
 
 

@@ -41,7 +41,7 @@ def with_rows(base_geometry, extra, observable, rng):
 def ks_spread(data, seed=1):
     """90 % width of log k_s and log rho_d under the posterior (emcee, converged)."""
     posterior = Posterior.build(data, Model.from_string("paper"))
-    flat = invert(posterior, seed=seed, progress=False).result.flat_samples()
+    flat = invert(posterior, seed=seed, progress=False).draws.flat_samples()
     names = posterior.priors.names
     widths = [np.subtract(*np.percentile(np.log(flat[:, names.index(n)]), [95, 5])) for n in ("ks", "rho_d")]
     return np.array(widths)

@@ -8,7 +8,7 @@ from spacepol.infer.engines.ga import _decode
 from spacepol.infer.objective import PaperObjective
 from spacepol.infer.prior_set import PriorSet
 from spacepol.infer.priors import Fixed, Uniform
-from spacepol.infer.result import Result
+from spacepol.infer.engine_result import EngineResult
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 
@@ -34,7 +34,7 @@ def test_ga_coding_rounds_and_spans_the_range():
 
 def test_ga_follows_the_paper_settings(objective):
     res = optimize("ga", objective, np.random.default_rng(0))
-    assert isinstance(res, Result) and res.method == "ga"
+    assert isinstance(res, EngineResult) and res.method == "ga"
     assert res.n_evaluations % 100 == 0 and res.n_evaluations <= 100 * 101  # population 100, <= 100 generations
     assert res.info["generations"] <= 100
     if res.info["stop_reason"] != "max_generations":
@@ -54,7 +54,7 @@ def test_every_method_returns_the_same_result_type(objective):
     for method in OPTIMIZERS:
         res = optimize(method, objective, np.random.default_rng(2), max_evaluations=400) if method != "ga" else \
             optimize(method, objective, np.random.default_rng(2), max_generations=3)
-        assert isinstance(res, Result) and set(res.best) == set(objective.names) and res.seconds >= 0
+        assert isinstance(res, EngineResult) and set(res.best) == set(objective.names) and res.seconds >= 0
         assert res.objective == pytest.approx(float(objective(res.best_vector()[None, :])[0]), rel=1e-9)
 
 

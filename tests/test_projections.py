@@ -4,7 +4,7 @@ forward maps (independent of the module's own h, k formulas), inverses, the zeni
 import numpy as np
 import pytest
 
-from spacepol.sky.projections import PROJECTIONS, cap_fraction
+from spacepol.skylight.projections import PROJECTIONS, cap_fraction
 
 ZEN = np.linspace(0.5, 89.5, 179)
 AZ = np.linspace(0.0, 350.0, 36)

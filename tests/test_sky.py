@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from spacepol.sky.directions import fold_axial, local_frame, unit_vector
-from spacepol.sky.neutral_points import BerryDennisLeeSky
-from spacepol.sky.rayleigh import RayleighSky, paper_aop
-from spacepol.sky.sun import sun_position
+from spacepol.skylight.directions import fold_axial, local_frame, unit_vector
+from spacepol.skylight.neutral_points import BerryDennisLeeSky
+from spacepol.skylight.rayleigh import RayleighSky, paper_aop
+from spacepol.skylight.sun import sun_position
 
 
 def test_sun_at_changchun_on_16_december_2020():

@@ -22,11 +22,13 @@ def _int_at_least(low: int):
 
 def _wavelengths(text: str):
     """``0.633`` -> 0.633; ``0.532,0.633`` -> [0.532, 0.633]; ``all`` -> "all"."""
-    if text.strip().lower() == "all":
-        return "all"
-    one = _finite(0.0, strict=True)
-    values = [one(t.strip()) for t in text.split(",")]
-    return values[0] if len(values) == 1 else values
+    from .api import parse_wavelengths
+    from .errors import ParameterError
+
+    try:
+        return parse_wavelengths(text)
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _finite(low: float | None = None, strict: bool = False):

@@ -7,7 +7,6 @@ broken set never stops the others.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import io
 import json
@@ -20,30 +19,24 @@ SETTINGS_FILE = "batch_settings.json"
 
 
 def run_job(job: BatchJob, out: str) -> dict:
-    """Invert one set into ``out/<id>/``; the results row ``{id, status, seconds, error, summary}``."""
+    """Invert one set into ``out/<id>/`` (``api.invert``); the results row ``{id, status, seconds, error, summary}``."""
     from .._runtime import configure_process
-    from ..cli import _wavelengths
+    from ..api import invert, load
     from ..errors import SpacepolError
 
     configure_process(small_calls=True)  # a fresh worker (Dask's) before its first computation; elsewhere a no-op
 
     folder = Path(out) / job.id
     start = time.perf_counter()
-    args = argparse.Namespace(
-        data=job.data, model=job.model, prior=job.prior, observables=job.observables, seed=job.seed,
-        wavelength_um=None, dispersion=None, in_plane=False, walkers=None, steps=20000, restart=False,
-        robust=False, quiet=True, reference=[], out=str(folder))
     try:
-        if job.wavelength_um:
-            args.wavelength_um = _wavelengths(job.wavelength_um)
-        from .. import commands
-
+        data = load(job.data, job.wavelength_um)
         with contextlib.redirect_stdout(io.StringIO()):
-            commands.run(args)
-        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+            invert(data, job.model, job.prior, "emcee", job.seed, folder, observables=job.observables)
+        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))  # as the table's later readers see it
         (folder / SETTINGS_FILE).write_text(json.dumps(job.settings(), indent=1), encoding="utf-8")
-        return {"id": job.id, "status": "ok", "seconds": time.perf_counter() - start, "error": "", "summary": summary}
-    except (SpacepolError, argparse.ArgumentTypeError, OSError) as exc:
+        return {"id": job.id, "status": "ok", "seconds": time.perf_counter() - start, "error": "",
+                "summary": summary}
+    except (SpacepolError, OSError) as exc:
         error = str(exc)
     except Exception as exc:  # a bug of ours: still one line, and the other sets go on
         error = f"internal error: {type(exc).__name__}: {exc}"

@@ -78,7 +78,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
              priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
              posterior_method: str = "laplace", searched: dict | None = None) -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
-    ``base``: an Inversion of ``model`` on these data already at hand (it is not refitted); ``confirm``:
+    ``base``: a Result of ``model`` on these data already at hand (it is not refitted); ``confirm``:
     change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
     parameters to refit besides (for diagnose --rounds, which may take one when nothing is significant);
     ``posterior_method``: how each fit's posterior is drawn (``fit_for_elpd``); ``searched``: the maxima already
@@ -98,7 +98,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             _say(f"[base] fitting {model.name} ({len(data)} geometries) ...")
         base = fit_for_elpd(base_post, _vector(base_optimum, base_post), seed, max_steps, posterior_method)
     base_loo = base.loo["pointwise"]
-    base_fit = median_fit(base.posterior, base.result.flat_samples())
+    base_fit = median_fit(base.posterior, base.draws.flat_samples())
     clock["base"] = time.perf_counter()
 
     if progress:
@@ -141,7 +141,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     # at its end) and that their optima alone already show to differ significantly are not refitted
     asked = [c for c in to_confirm if c["change"] in confirm]
     if asked:
-        best = np.array([base.result.best[n] for n in base_post.priors.names], float)
+        best = np.array([base.draws.best[n] for n in base_post.priors.names], float)
         base_pointwise = base_post.log_prob_pointwise(best[None, :])[0]
     decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(base.loo.get("p_loo", 0.0)))]
     to_confirm = [c for c in to_confirm if c not in decided]
@@ -236,7 +236,7 @@ POSTERIOR_METHODS = ("laplace", "emcee")
 
 
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
-    """The Inversion whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
+    """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
     Laplace approximation corrected by importance sampling (``inversion.invert_laplace``), where its Pareto k
     trusts it, else emcee; "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``, ``paper+lambertian``)
     the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
@@ -261,7 +261,7 @@ def posterior_quality(inv) -> dict:
     rhat, ess = d.get("rhat_max"), d.get("ess_min")
     converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET
     return {"engine": engine, "converged": bool(converged), "rhat_max": rhat, "ess_min": ess,
-            "steps": inv.result.info.get("steps")}
+            "steps": inv.draws.info.get("steps")}
 
 
 def _unconverged(quality: dict) -> str:
@@ -300,8 +300,8 @@ def signatures(base, inv, base_fit=None) -> dict:
     prediction in the same noise units (its signature), their correlation and the share of the
     base chi^2 the candidate removes. ``base_fit``: the base's ``median_fit``, if already computed."""
     lik = base.posterior.likelihood
-    mu0, scale = base_fit or median_fit(base.posterior, base.result.flat_samples())
-    mu1, _ = median_fit(inv.posterior, inv.result.flat_samples())
+    mu0, scale = base_fit or median_fit(base.posterior, base.draws.flat_samples())
+    mu1, _ = median_fit(inv.posterior, inv.draws.flat_samples())
     out = {}
     for o in base.posterior.likelihood.observables:
         observed = lik.standardise(o, mu0[o], scale[o])

@@ -139,8 +139,8 @@ def identifiable(effect: str, names: list[str], samples: np.ndarray, truth: dict
 
 def covered(effect: str, inversion, truth: dict) -> dict[str, bool]:
     """Is each hidden parameter inside the 5-95 % interval of its (identifiable) marginal?"""
-    names = inversion.result.names
-    samples, truth = identifiable(effect, names, inversion.result.flat_samples(), truth)
+    names = inversion.draws.names
+    samples, truth = identifiable(effect, names, inversion.draws.flat_samples(), truth)
     out = {}
     for name, value in truth.items():
         lo, hi = np.percentile(samples[:, names.index(name)], [5, 95])

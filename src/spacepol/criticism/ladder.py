@@ -18,7 +18,7 @@ from .changes import parse, start_points
 def climb(data, model: Model, additions: list[str], seed: int = 0, observables=None, max_steps: int = 8000,
           progress: bool = True, fitted: dict | None = None) -> list[dict]:
     """One rung per change: ``additions`` are effect names or change labels ("replace shadowing by smith",
-    "remove body"), applied in order.  ``fitted``: {model name: Inversion} already at hand on these data
+    "remove body"), applied in order.  ``fitted``: {model name: Result} already at hand on these data
     (e.g. from diagnose); reused."""
     rungs, current, fitted = [], model, fitted or {}
     for step in [None] + list(additions):

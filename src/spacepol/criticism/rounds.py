@@ -24,7 +24,7 @@ def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives
 
 
 def as_rungs(result: dict) -> list[dict]:
-    """The path as ladder rungs (for the ladder figure and table), with each round's Inversion."""
+    """The path as ladder rungs (for the ladder figure and table), with each round's Result."""
     inversions = [result["_reports"][0]["_base"]]
     for report, step in zip(result["_reports"], result["rounds"][1:]):
         inversions.append(next(c["inversion"] for c in report["_confirmed"] if c["change"] == step["change"]))

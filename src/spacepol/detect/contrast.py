@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.geometry import Geometry
-from ..sky.neutral_points import BerryDennisLeeSky
-from ..sky.rayleigh import RayleighSky
-from ..sky.sun import sun_position
+from ..skylight.neutral_points import BerryDennisLeeSky
+from ..skylight.rayleigh import RayleighSky
+from ..skylight.sun import sun_position
 from . import radiometry as R
 
 THETA_R_GRID = 81
@@ -58,7 +58,7 @@ def material_samples(model, samples: dict, scenario, spec, extrapolate: bool = F
             params, rule = model.values_at_wavelength(samples, lam, extrapolate)
         except SpacepolError as exc:
             raise SpacepolError(f"contrast: the scenario's {exc} (set [target] wavelength_um in the scenario, or pass "
-                                "--extrapolate)") from None
+                                "--extrapolate: extrapolate=True in the API)") from None
         return model.model, params, {"wavelength_um": lam, "measured_wavelengths_um": list(model.wavelengths),
                                      "rule": rule, "extrapolated": not (model.wavelengths[0] <= lam <= model.wavelengths[-1])}
     measured = spec.get("wavelengths_um") if isinstance(spec, dict) else None
@@ -66,6 +66,26 @@ def material_samples(model, samples: dict, scenario, spec, extrapolate: bool = F
     return model, samples, {"wavelength_um": lam, "measured_wavelengths_um": measured,
                             "rule": f"the run's one-wavelength posterior{at} used as measured (no dispersion to "
                                     f"{lam:g} um modelled)", "extrapolated": bool(measured) and abs(measured[0] - lam) > 1e-9}
+
+
+def contrast_of(result, scenario, seed: int = 0, draws: int = 20000, reading: str = "corrected",
+                extrapolate: bool = False) -> tuple[dict, dict]:
+    """(contrast.json's content, {case: {quantity: draws}}) of a run's Result (``infer.result``) in ``scenario``: the
+    Result's own model (rebuilt from its stored spec) and draws; over several wavelengths n, k at the scenario's
+    wavelength (``material_samples``). The content's ``material`` says which rule gave them; ``seed`` seeds the one
+    Generator of the propagation."""
+    from ..errors import SpacepolError
+    from .paper_table3 import recompute
+
+    samples, spec = result.samples(), result.summary.get("spec", result.summary["model"])
+    if isinstance(spec, str) and any("@" in name for name in samples):
+        raise SpacepolError("contrast: the run has per-wavelength parameters but its summary.json stores only the model's "
+                            "name; run it again with this version to store the whole model")
+    inner, params, material = material_samples(result.model, samples, scenario, spec, extrapolate)
+    report = propagate(inner, params, scenario, np.random.default_rng(seed), draws=draws, reading=reading)
+    per_case = report.pop("draws_by_case")
+    report.update(material=material, paper_table3=recompute(scenario.instrument), model=spec, seed=seed)
+    return report, per_case
 
 
 def target_dop_grid(model, samples: dict, scenario) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +126,7 @@ def case_rows(p_target, p_sky, scenario, reading):
 
 def propagate(model, samples: dict, scenario, rng: np.random.Generator, draws: int = 20000,
               reading: str = "corrected") -> dict:
-    """contrast.json's content (DESIGN fields) plus the draws themselves under ``_draws``."""
+    """contrast.json's content (DESIGN fields) plus the draws themselves under ``draws_by_case``."""
     sun = sun_position(scenario.site["lat_deg"], scenario.site["lon_deg"], scenario.site["time"])
     theta_r, grid = target_dop_grid(model, samples, scenario)
     inst = scenario.instrument
@@ -131,7 +151,7 @@ def propagate(model, samples: dict, scenario, rng: np.random.Generator, draws: i
         "radiometry": {"N_s": float(n_s), "N_B": float(n_b), "noise": float(noise), "snr": float(n_s / noise),
                        "limit_flux_photons_m2_s": flux, "limit_flux_for_required_snr": float(R.limit_flux(inst)),
                        "magnitude_of_limit_flux": float(R.magnitude(flux, inst))},
-        "rows": rows, "_draws": draws_out,
+        "rows": rows, "draws_by_case": draws_out,
     }
 
 

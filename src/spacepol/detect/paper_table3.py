@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..sky.rayleigh import RayleighSky
+from ..skylight.rayleigh import RayleighSky
 from . import radiometry as R
 
 P_TARGET_RANGE = (0.002, 0.48)

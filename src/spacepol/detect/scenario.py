@@ -117,8 +117,14 @@ def default_scenario() -> Scenario:
 
 
 def read_scenario(path) -> Scenario:
+    """The scenario of a TOML file (sections as ``default_scenario``'s; any key left out keeps its default)."""
     path = Path(path)
-    data = read_toml(path, "scenario")
+    return scenario_from_dict(read_toml(path, "scenario"), str(path))
+
+
+def scenario_from_dict(data: dict, path: str = "scenario") -> Scenario:
+    """The scenario of a dict laid out as the TOML file (``{"target": {"wavelength_um": 0.8}, "cases": [...]}``),
+    checked as a file is; ``path`` names it in error messages."""
     unknown = sorted(set(data) - set(SECTIONS) - {"cases"})
     if unknown:
         raise SpacepolError(f"{path}: unknown section(s) {', '.join(unknown)} (known: {', '.join(SECTIONS)}, cases)")
@@ -155,7 +161,7 @@ def read_scenario(path) -> Scenario:
 def check_scenario(s: Scenario, where: str) -> None:
     """Checks that need several keys at once, or a computation: the site, the time, a band whose flux
     is finite and positive (a band far from the star's spectrum underflows to zero photons)."""
-    from ..sky.sun import parse_time
+    from ..skylight.sun import parse_time
     from .radiometry import magnitude
 
     if not -90 <= s.site["lat_deg"] <= 90:

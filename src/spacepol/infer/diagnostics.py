@@ -9,10 +9,10 @@ import numpy as np
 
 from .inference_data import median_fit, model_dop
 from .posterior import Posterior
-from .result import Result
+from .engine_result import EngineResult
 
 
-def convergence(idata, result: Result) -> dict:
+def convergence(idata, result: EngineResult) -> dict:
     """R-hat (rank-normalised) and bulk and tail ESS per parameter from ArviZ, their worst values, and the engine's
     autocorrelation time and acceptance fraction where it reports them."""
     rhat = az.rhat(idata)
@@ -64,7 +64,7 @@ def loo_fields(pointwise: np.ndarray, pareto_k: np.ndarray, p_loo: float, labels
             "pareto_k_bad": [labels[i] for i in np.flatnonzero(pareto_k > PARETO_K_LIMIT)], "pointwise": pointwise}
 
 
-def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> dict:
+def fit_statistics(posterior: Posterior, result: EngineResult, loo_result: dict) -> dict:
     """RMSE of DOP (also when DOP is not fitted but measured: a Mueller fit predicts it) and reduced chi^2
     at the posterior-median prediction."""
     lik = posterior.likelihood
@@ -79,7 +79,7 @@ def fit_statistics(posterior: Posterior, result: Result, loo_result: dict) -> di
             "elpd_loo_se": loo_result["elpd_loo_se"]}
 
 
-def quantiles(result: Result) -> dict:
+def quantiles(result: EngineResult) -> dict:
     """``quantile_dict`` of every free parameter's draws, by name."""
     flat = result.flat_samples()
     return {name: quantile_dict(flat[:, j]) for j, name in enumerate(result.names)}

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .posterior import Posterior
-from .result import Result
+from .engine_result import EngineResult
 
 WEAK_RATIO = 0.5  # posterior 90 % width above half the prior's: barely measured
 STRONG_CORRELATION = 0.8
@@ -86,7 +86,7 @@ def bound_finding(flag: dict) -> str:
             f"(the posterior is cut off by the prior, so its interval is not a measurement).")
 
 
-def identifiability(posterior: Posterior, result: Result) -> dict:
+def identifiability(posterior: Posterior, result: EngineResult) -> dict:
     """What the draws can and cannot say about each parameter: those piled at a bound, those barely narrower than
     their prior (posterior / prior 90 % width), strongly correlated pairs, and (DOP without BRDF) intensity
     weights of which only the ratio is measured; with findings in words."""

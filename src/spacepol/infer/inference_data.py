@@ -9,7 +9,7 @@ import arviz as az
 import numpy as np
 
 from .posterior import Posterior
-from .result import Result
+from .engine_result import EngineResult
 
 
 # Pointwise groups (log-likelihood, replicates) hold draws x observations numbers; above this many the
@@ -75,7 +75,7 @@ def replicate(posterior: Posterior, means, scales, rng: np.random.Generator):
     return {ch: lik.replicate(ch, mu, scales[ch], rng) for ch, mu in means.items()}
 
 
-def to_inference_data(result: Result, posterior: Posterior, rng: np.random.Generator,
+def to_inference_data(result: EngineResult, posterior: Posterior, rng: np.random.Generator,
                       max_pointwise_draws: int | None = None) -> az.InferenceData:
     """The run as ArviZ groups; the pointwise groups (log_likelihood, posterior_predictive) from every k-th draw
     (``pointwise_thinning``), at most ``max_pointwise_draws`` draws in all when given."""

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import hashlib
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -20,23 +19,9 @@ from .identifiability import identifiability
 from .inference_data import batched, to_inference_data
 from .laplace import importance_loo, laplace_importance
 from .posterior import Posterior
+from .engine_result import EngineResult
 from .result import Result
 from .sampling_space import SamplingSpace
-
-
-@dataclass
-class Inversion:
-    """One inversion's whole outcome: the ``posterior`` it sampled (data, model, priors), the engine's ``result``
-    (draws, best point), the ArviZ ``idata`` (posterior, sample_stats, log_likelihood, posterior_predictive,
-    observed_data), the ``summary`` written as summary.json, the PSIS-LOO record ``loo`` and the
-    ``identifiability`` findings."""
-
-    posterior: Posterior
-    result: Result
-    idata: object
-    summary: dict
-    loo: dict
-    identifiability: dict
 
 
 def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.family) -> str:
@@ -84,7 +69,7 @@ def check_walkers(walkers: int | None, ndim: int) -> int:
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
            backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None,
-           tau_multiple: float = 50.0, max_pointwise_draws: int | None = None) -> Inversion:
+           tau_multiple: float = 50.0, max_pointwise_draws: int | None = None) -> Result:
     """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
     around which the walkers start; by default a global optimisation finds one. ``space``: where the walkers
     move (``sampling_space``; default the logit of each prior's CDF). ``tau_multiple``: the chain is long
@@ -109,7 +94,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     return _inversion(posterior, result, idata, loo_result, convergence(idata, result), seed, start)
 
 
-def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) -> Inversion | None:
+def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) -> Result | None:
     """The posterior from a Laplace approximation at the mode nearest ``centre``, corrected by Pareto-smoothed
     importance sampling (``laplace``): ``draws`` equally weighted draws resampled from as many weighted ones, and
     PSIS-LOO that accounts for the approximation. None where the approximation cannot be trusted (Pareto k > 0.7,
@@ -127,7 +112,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     best = centre if centre_value >= sample.log_prob.max() else sample.theta[int(np.argmax(sample.log_prob))]
     info = {"engine": "laplace-is", "draws": len(sample.theta), "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
             "proposal": sample.proposal}
-    result = Result(method="laplace-is", model=posterior.likelihood.model.name, names=names,
+    result = EngineResult(method="laplace-is", model=posterior.likelihood.model.name, names=names,
                     best=dict(zip(names, map(float, best))), objective=-float(max(centre_value, sample.log_prob.max())),
                     objective_name="negative_log_posterior", n_evaluations=posterior.n_evaluations,
                     seconds=time.perf_counter() - start, seed=seed, samples=sample.theta[kept][:, None, :],
@@ -141,9 +126,9 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     return _inversion(posterior, result, idata, loo_result, diagnostics, seed, start)
 
 
-def _inversion(posterior: Posterior, result: Result, idata, loo_result: dict, diagnostics: dict, seed: int,
-               start: float) -> Inversion:
-    """The Inversion of a posterior's draws: summary (quantiles, fit, noise ratios, identifiability, residual
+def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: dict, diagnostics: dict, seed: int,
+               start: float) -> Result:
+    """The Result of a posterior's draws: summary (quantiles, fit, noise ratios, identifiability, residual
     structure) and the ArviZ groups."""
     summary = {
         "model": posterior.likelihood.model.name,
@@ -179,7 +164,7 @@ def _inversion(posterior: Posterior, result: Result, idata, loo_result: dict, di
     structure = analyse(posterior, result.flat_samples())
     summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
                                      "structured": structure.structured()}
-    return Inversion(posterior, result, idata, summary, loo_result, ident)
+    return Result(posterior, result, idata, summary, loo_result, ident)
 
 
 EXPLAINED_NOISE_RATIO = 1.5  # a model explains the data when no inferred noise level exceeds the measured one by more

@@ -1,79 +1,213 @@
-"""One Result type for every engine (emcee, the paper's GA, nlopt, scipy DE)."""
+"""One inversion's whole outcome, whatever engine made it: the ArviZ groups, the typed diagnostics, the engine
+and its settings, the seed and the full model spec; ``save(dir)`` and ``Result.load(dir)`` round-trip it.
+
+A Result made by an engine also holds the :class:`~spacepol.infer.posterior.Posterior` it sampled (data, model,
+priors: what the figures and criticism need). A loaded Result has no Posterior: its data are in the
+``observed_data`` group and its model is rebuilt from the stored spec (``Result.model``).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+from ..errors import SpacepolError
+from .engine_result import EngineResult
+from .engines.emcee_sampler import ESS_TARGET, RHAT_TARGET
+
+SUMMARY_FILE = "summary.json"
+POSTERIOR_FILE = "posterior.nc"
+
+
+@dataclass(frozen=True)
+class Diagnostics:
+    """How the draws were obtained and whether they can be trusted. MCMC: R-hat <= 1.01 and ESS >= 400 for every
+    parameter and no step cap hit. Laplace-IS: importance weights that passed their Pareto-k and width checks
+    (``pareto_k``; ``ess_min`` is then the effective number of draws)."""
+
+    engine: str
+    converged: bool
+    rhat_max: float | None
+    ess_min: float | None
+    tau_max: float | None
+    steps: int | None
+    pareto_k: float | None
+    capped: bool
+
+    def to_json(self) -> dict:
+        """The fields as a JSON-ready dict."""
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class Fit:
+    """How well the posterior-median model matches the data: reduced chi^2, RMSE of DOP (None without measured
+    DOP), ELPD-LOO and its standard error, and the misfit per noise group (inferred / measured noise, where the
+    data measure their own noise)."""
+
+    chi2_red: float
+    rmse_dop: float | None
+    elpd_loo: float
+    elpd_loo_se: float
+    misfit: dict[str, float]
+
+    def to_json(self) -> dict:
+        """The fields as a JSON-ready dict."""
+        return dict(self.__dict__)
+
+
+def _finite_or_none(value) -> float | None:
+    return None if value is None or not np.isfinite(value) else float(value)
 
 
 @dataclass
 class Result:
-    """What an engine returns: an optimizer's best point and its search history, or a sampler's draws
-    (``samples``: draws x chains x D, after burn-in and thinning) with their log posterior; ``info`` holds the
-    engine's own settings and diagnostics."""
+    """One inversion: ``posterior`` (data, model, priors; None for a loaded Result), ``draws`` (the engine's
+    draws and best point), ``idata`` (ArviZ groups posterior, sample_stats, log_likelihood, posterior_predictive,
+    observed_data), ``summary`` (what summary.json holds), ``loo`` (the PSIS-LOO record) and
+    ``identifiability``. Typed views: ``diagnostics``, ``fit``, ``spec``, ``engine``, ``seed``, ``log_evidence``;
+    draws by name: ``samples()``."""
 
-    method: str
-    model: str
-    names: list[str]
-    best: dict[str, float]  # optimum (optimizers) or MAP sample (emcee), free parameters only
-    objective: float  # the engine's objective at ``best`` (lower is better)
-    objective_name: str
-    n_evaluations: int
-    seconds: float
-    seed: int
-    history: np.ndarray | None = None  # (k, 2): evaluations so far, best objective so far
-    samples: np.ndarray | None = None  # (draws, chains, D) posterior samples after burn-in and thinning
-    log_prob: np.ndarray | None = None  # (draws, chains)
-    info: dict = field(default_factory=dict)
+    posterior: object | None
+    draws: EngineResult
+    idata: object
+    summary: dict
+    loo: dict
+    identifiability: dict
 
-    def best_vector(self) -> np.ndarray:
-        """``best`` as a vector in ``names`` order."""
-        return np.array([self.best[n] for n in self.names])
+    @property
+    def engine(self) -> str:
+        """The engine that made the draws (emcee, laplace-is, nuts, ...)."""
+        return self.summary.get("diagnostics", {}).get("engine") or self.draws.method
 
-    def flat_samples(self) -> np.ndarray:
-        """The draws of every chain stacked: (draws x chains, D). An optimizer's result has none (ValueError)."""
-        if self.samples is None:
-            raise ValueError(f"{self.method} gives a point estimate, not samples")
-        return self.samples.reshape(-1, self.samples.shape[-1])
+    @property
+    def engine_settings(self) -> dict:
+        """The engine's own settings and run figures (walkers, steps, burn-in, thinning, ...)."""
+        return dict(self.summary.get("sampler", {}))
 
-    def to_json(self) -> dict:
-        """The result as JSON-ready fields (what ``optimize`` prints)."""
-        out = {
-            "method": self.method, "model": self.model, "best": self.best,
-            "objective": self.objective, "objective_name": self.objective_name,
-            "n_evaluations": self.n_evaluations, "seconds": self.seconds, "seed": self.seed,
-        }
-        out.update({k: v for k, v in self.info.items() if isinstance(v, (int, float, str, bool, list, dict))})
+    @property
+    def seed(self) -> int:
+        """The seed of the one Generator the run used."""
+        return int(self.summary["seed"])
+
+    @property
+    def spec(self) -> dict:
+        """The whole model: effects, plug-in sources, wavelengths, dispersion (``physics.model_spec``), and the
+        observables fitted and the priors used."""
+        spec = self.summary.get("spec", self.summary["model"])
+        spec = {"effects": spec, "plugins": {}, "wavelengths_um": None, "dispersion": {}} if isinstance(spec, str) else spec
+        return {**spec, "observables": list(self.summary.get("observables", [])),
+                "priors": dict(self.summary.get("priors", {})),
+                "fixed": dict(self.summary.get("fixed", {}))}
+
+    @property
+    def model(self):
+        """The Model (one wavelength) or SpectralModel, rebuilt from the spec for a loaded Result."""
+        if self.posterior is not None:
+            return self.posterior.likelihood.model
+        from ..physics.model_spec import model_from_spec
+
+        return model_from_spec(self.summary.get("spec", self.summary["model"]))
+
+    @property
+    def log_evidence(self) -> tuple[float, float] | None:
+        """(ln Z, its standard error) when the engine estimates the evidence (a nested sampler), else None."""
+        value = self.summary.get("log_evidence")
+        return None if value is None else (float(value["value"]), float(value["error"]))
+
+    @property
+    def diagnostics(self) -> Diagnostics:
+        """Convergence or importance-weight diagnostics, typed."""
+        d, sampler = self.summary.get("diagnostics", {}), self.summary.get("sampler", {})
+        engine = d.get("engine") or self.draws.method
+        capped = bool(sampler.get("capped", False))
+        if engine == "laplace-is":
+            converged = True  # invert_laplace returns only weights that passed its checks
+        else:
+            rhat, ess = d.get("rhat_max"), d.get("ess_min")
+            converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET and not capped
+        steps = sampler.get("steps")
+        return Diagnostics(engine=engine, converged=bool(converged), rhat_max=_finite_or_none(d.get("rhat_max")),
+                           ess_min=_finite_or_none(d.get("ess_min")), tau_max=_finite_or_none(d.get("tau_max")),
+                           steps=None if steps is None else int(steps), pareto_k=_finite_or_none(d.get("pareto_k")),
+                           capped=capped)
+
+    @property
+    def fit(self) -> Fit:
+        """Fit statistics, typed."""
+        f = self.summary["fit"]
+        return Fit(chi2_red=float(f["chi2_red"]), rmse_dop=f.get("rmse_dop"), elpd_loo=float(f["elpd_loo"]),
+                   elpd_loo_se=float(f["elpd_loo_se"]),
+                   misfit={k: float(v["ratio"]) for k, v in self.summary.get("noise", {}).items()})
+
+    def samples(self, include_fixed: bool = True) -> dict[str, np.ndarray]:
+        """{parameter: flat draws} of every free parameter; fixed parameters as 0-d arrays when ``include_fixed``."""
+        flat = self.draws.flat_samples()
+        out = {name: flat[:, j] for j, name in enumerate(self.draws.names)}
+        if include_fixed:
+            for name, value in self.summary.get("fixed", {}).items():
+                out.setdefault(name, np.asarray(float(value)))
         return out
 
+    def median(self) -> dict[str, float]:
+        """The posterior median of every free parameter."""
+        return {name: float(np.median(v)) for name, v in self.samples(include_fixed=False).items()}
 
-class History:
-    """Best objective against evaluations, recorded as an engine runs."""
+    def to_json(self) -> dict:
+        """summary.json's content (its fixed fields: model, spec, parameters, diagnostics, fit, seconds, seed,
+        observables, priors, fixed, map, sampler, identifiability)."""
+        return self.summary
 
-    def __init__(self):
-        self.evaluations = 0
-        self.best = np.inf
-        self.best_x = None
-        self.points: list[tuple[int, float]] = []
+    def save(self, folder) -> Path:
+        """Write ``posterior.nc`` (ArviZ groups, the pointwise ones thinned for storage) and ``summary.json`` into
+        ``folder`` (made if missing); returns the folder."""
+        from ..io.atomic import atomic_path, write_json
+        from .inference_data import for_storage
 
-    def record(self, x, values):
-        values = np.atleast_1d(values)
-        x = np.atleast_2d(x)
-        self.evaluations += len(values)
-        i = int(np.argmin(values))
-        if values[i] < self.best:
-            self.best, self.best_x = float(values[i]), x[i].copy()
-        self.points.append((self.evaluations, self.best))
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        with atomic_path(folder / POSTERIOR_FILE) as tmp:
+            for_storage(self.idata).to_netcdf(str(tmp))
+        write_json(folder / SUMMARY_FILE, self.summary)
+        return folder
 
-    def as_array(self):
-        return np.array(self.points, dtype=float)
+    @classmethod
+    def load(cls, folder) -> "Result":
+        """The Result a ``save`` (or ``invert-mcmc run``) wrote into ``folder``; one clear error when it is not
+        such a folder or its files are damaged."""
+        import arviz as az
 
-    def to_result(self, method, objective, model_name, seconds, seed, info) -> Result:
-        """The Result of an optimizer that recorded its evaluations here."""
-        return Result(
-            method=method, model=model_name, names=list(objective.names),
-            best=dict(zip(objective.names, map(float, self.best_x))), objective=self.best,
-            objective_name=objective.name, n_evaluations=self.evaluations, seconds=seconds,
-            seed=-1 if seed is None else seed, history=self.as_array(), info=info,
-        )
+        folder = Path(folder)
+        if not folder.is_dir():
+            raise SpacepolError(f"{folder}: not a folder (give the --out folder of `invert-mcmc run` or Result.save)")
+        summary_path, posterior_path = folder / SUMMARY_FILE, folder / POSTERIOR_FILE
+        for path in (summary_path, posterior_path):
+            if not path.is_file():
+                raise SpacepolError(f"{path}: missing; is {folder} the output folder of `invert-mcmc run`?")
+        try:
+            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            summary = None
+        if not isinstance(summary, dict) or "model" not in summary:
+            raise SpacepolError(f"{summary_path}: not a spacepol summary (no 'model')")
+        try:
+            idata = az.from_netcdf(str(posterior_path))
+            post = idata.posterior
+        except Exception as exc:  # netCDF/HDF5 raise many types for a damaged file
+            raise SpacepolError(f"{posterior_path}: cannot read the posterior ({type(exc).__name__})") from None
+        names = [n for n in post.data_vars]
+        samples = np.stack([np.asarray(post[n]) for n in names], axis=-1).transpose(1, 0, 2)  # (draws, chains, D)
+        log_prob = (np.asarray(idata.sample_stats["lp"]).T if "sample_stats" in idata.groups()
+                    and "lp" in idata.sample_stats else None)
+        attrs = post.attrs
+        draws = EngineResult(method=str(attrs.get("method", summary.get("diagnostics", {}).get("engine", "emcee"))),
+                             model=summary["model"], names=names, best=dict(summary.get("map", {})),
+                             objective=np.nan, objective_name="negative_log_posterior", n_evaluations=0,
+                             seconds=float(summary.get("seconds", 0.0)), seed=int(summary.get("seed", -1)),
+                             samples=samples, log_prob=log_prob, info=dict(summary.get("sampler", {})))
+        return cls(posterior=None, draws=draws, idata=idata, summary=summary,
+                   loo={k: summary["fit"][k] for k in ("elpd_loo", "elpd_loo_se")} if "fit" in summary else {},
+                   identifiability=dict(summary.get("identifiability", {})))

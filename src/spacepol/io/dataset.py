@@ -69,13 +69,8 @@ class Dataset:
     def select(self, mask) -> "Dataset":
         """A subset of the rows (boolean mask or indices)."""
         idx = np.arange(len(self))[mask]
-        changes = {}
-        for name in ("theta_i", "theta_r", "dphi", "wavelength_um", "dop", "dop_err", "brdf", "brdf_err", "aop", "aop_err"):
-            value = getattr(self, name)
-            changes[name] = None if value is None else value[idx]
-        changes["stokes"] = None if self.stokes is None else self.stokes[:, idx]
-        changes["mueller"] = None if self.mueller is None else self.mueller[:, :, idx]
-        changes["mueller_err"] = None if self.mueller_err is None else self.mueller_err[:, :, idx]
+        changes = {name: None if (value := getattr(self, name)) is None else np.take(value, idx, axis=axis)
+                   for name, axis in _ROW_ARRAYS.items()}
         return replace(self, **changes)
 
     def in_plane(self, tolerance_deg: float = 1e-6) -> "Dataset":
@@ -104,3 +99,24 @@ class Dataset:
         out = self.select(self._rows_at(wavelength_um, tolerance_um))
         out.metadata = {**self.metadata, "wavelength_um": wavelength_um}
         return out
+
+    @classmethod
+    def concatenate(cls, parts: list["Dataset"]) -> "Dataset":
+        """The rows of several data sets in one (e.g. one file per wavelength). Every part must hold the same
+        observables and error columns; the metadata are the first part's, the source names every part."""
+        if not parts:
+            raise ValueError("Dataset.concatenate: no data sets given")
+        arrays = {}
+        for name, axis in _ROW_ARRAYS.items():
+            values = [getattr(p, name) for p in parts]
+            present = [v is not None for v in values]
+            if any(present) and not all(present):
+                missing = ", ".join(p.source or f"part {i + 1}" for i, p in enumerate(parts) if getattr(p, name) is None)
+                raise InputFileError(missing, f"has no '{name}' while the other data sets have it")
+            arrays[name] = np.concatenate(values, axis=axis) if all(present) else None
+        return cls(**arrays, metadata=dict(parts[0].metadata), source=" + ".join(p.source for p in parts))
+
+
+# every per-row array of a Dataset and the axis its rows lie on
+_ROW_ARRAYS = {"theta_i": 0, "theta_r": 0, "dphi": 0, "wavelength_um": 0, "dop": 0, "dop_err": 0, "brdf": 0,
+               "brdf_err": 0, "stokes": 1, "aop": 0, "aop_err": 0, "mueller": 2, "mueller_err": 2}

@@ -117,8 +117,7 @@ class SpectralModel:
         lo, hi = self.wavelengths[0], self.wavelengths[-1]
         outside = lam < lo * (1 - 1e-9) or lam > hi * (1 + 1e-9)
         if outside and not extrapolate:
-            raise ParameterError(f"wavelength {lam:g} um lies outside the run's measured {lo:g}-{hi:g} um "
-                                 "(choose one inside it, or extrapolate explicitly)")
+            raise ParameterError(f"wavelength {lam:g} um lies outside the run's measured {lo:g}-{hi:g} um")
         out = {k: params[k] for k in self.shared if k in params}
         rules = []
         grid = np.array(self.wavelengths)

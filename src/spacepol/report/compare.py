@@ -47,7 +47,7 @@ def run_comparison(posterior, data, out: Path, methods=None, seeds: int = 3, bas
                 print(f"  {method} seed {seed} ...", flush=True)
             if method == "emcee":
                 inv = invert(posterior, seed=seed, progress=False)
-                res = inv.result
+                res = inv.draws
                 point = np.array([[res.best.get(n, posterior.priors.fixed.get(n)) for n in objective.names]])
                 value = float(objective(point)[0])
                 runs.append({"method": method, "seed": seed, "objective": value, "best": {n: float(point[0, j]) for j, n in enumerate(objective.names)},

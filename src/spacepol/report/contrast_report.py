@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import SpacepolError
 from ..io.atomic import atomic_path, save_figure, write_json
 from . import html as H
 from .sky_figures import contrast_histograms
@@ -35,29 +34,16 @@ def dominance_paragraph(report: dict) -> str:
     return " ".join(parts)
 
 
-def make_contrast_report(run_dir, scenario, out: Path, reading: str = "corrected", draws: int = 20000, seed: int = 0,
-                         extrapolate: bool = False) -> dict:
-    """Load the run's posterior, propagate it through the scenario, write the files; returns contrast.json's content.
-    ``extrapolate``: allow a scenario wavelength outside a multi-wavelength run's measured range."""
-    import numpy as np
+def make_contrast_report(result, scenario, out: Path, reading: str = "corrected", draws: int = 20000, seed: int = 0,
+                         extrapolate: bool = False, label: str | None = None) -> dict:
+    """Propagate a run's Result (``infer.result``) through the scenario and write the files; returns contrast.json's
+    content. ``extrapolate``: allow a scenario wavelength outside a multi-wavelength run's measured range;
+    ``label``: how the report names the run (its folder)."""
+    from ..detect.contrast import contrast_of
 
-    from ..detect.contrast import material_samples, propagate
-    from ..detect.paper_table3 import recompute
-    from ..io.run_dir import load_run
-    from ..physics.model_spec import model_from_spec
-
-    spec, samples, summary = load_run(run_dir)
-    if isinstance(spec, str) and any("@" in name for name in samples):
-        raise SpacepolError(f"{run_dir}: the run has per-wavelength parameters but its summary.json stores only the model's "
-                            "name; run it again with this version to store the whole model")
-    model = model_from_spec(spec, str(run_dir))
-    inner, params, material = material_samples(model, samples, scenario, spec, extrapolate)
-    report = propagate(inner, params, scenario, np.random.default_rng(seed), draws=draws, reading=reading)
-    report["material"] = material
-    report["paper_table3"] = recompute(scenario.instrument)
-    report["model"] = spec
-    report["seed"] = seed
-    write_contrast_report(report, out, str(run_dir), assumptions(summary, scenario, material))
+    report, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
+    write_contrast_report(report, per_case, out, label or result.summary["model"],
+                          assumptions(result.summary, scenario, report["material"]))
     return report
 
 
@@ -77,10 +63,11 @@ def assumptions(summary: dict, scenario, material: dict | None = None) -> list[s
     ]
 
 
-def write_contrast_report(report: dict, out: Path, run_dir: str, assumptions: list[str]) -> None:
+def write_contrast_report(report: dict, draws: dict, out: Path, run_dir: str, assumptions: list[str]) -> None:
+    """contrast.json (``report`` completed with the dominance paragraph and the assumptions), table3.md,
+    contrast_histograms.png (``draws``: {case: {quantity: draws}}) and report.html in ``out``."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    draws = report.pop("_draws")
     report["dominance"] = dominance_paragraph(report)
     report["assumptions"] = assumptions
     save_figure(contrast_histograms(draws), out / "contrast_histograms.png")

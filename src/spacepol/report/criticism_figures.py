@@ -13,7 +13,7 @@ from .panels import margin_colorbar, panel_grid, top_title
 def signature_figure(base, candidates, fig=None) -> Figure:
     """Observed residuals of the base fit (dots) against each candidate's signature (crosses).
 
-    ``base`` is the base model's Inversion, ``candidates`` a list of (effect name, its
+    ``base`` is the base model's Result, ``candidates`` a list of (effect name, its
     ``criticism.diagnose.signatures``). The signature of a candidate is what it changes in the prediction, in noise
     units: (posterior-median prediction of M + E) - (that of M), divided by the noise. Where the
     crosses follow the dots, the effect explains the misfit.
@@ -53,7 +53,7 @@ def ladder_figure(rungs, fig=None) -> Figure:
         inv = rung["_inversion"]
         ax = fig.add_subplot(grid[0, i])
         obs = inv.posterior.likelihood.observables[0]
-        z = standardised_residuals(inv.posterior, inv.result.flat_samples())[obs]
+        z = standardised_residuals(inv.posterior, inv.draws.flat_samples())[obs]
         data = inv.posterior.likelihood.data
         scatter = ax.scatter(signed_theta_r(data), z, s=8, c=data.theta_i, cmap="viridis")
         ax.axhline(0, color="k", lw=0.8)

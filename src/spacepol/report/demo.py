@@ -35,7 +35,7 @@ from . import html as H
 from .figures import dop_versus_theta_r
 from ..detect.scenario import default_scenario
 from ..io.atomic import save_figure
-from ..sky.rayleigh import RayleighSky
+from ..skylight.rayleigh import RayleighSky
 from .contrast_report import make_contrast_report, table3_lines
 from .diagnose_report import significance_statement, write_diagnose_report
 from .sky_figures import projection_distortion_figure, sky_maps_figure
@@ -190,7 +190,8 @@ def run_demo(out: Path, seed: int = 0) -> None:
 
     print("5/5 detecting a target of this material against the daytime sky: the paper's Table 3 as distributions")
     scenario = default_scenario()
-    contrast = make_contrast_report(out / "ptfe_paper", scenario, out / "contrast", "corrected", seed=seed)
+    contrast = make_contrast_report(inv, scenario, out / "contrast", "corrected", seed=seed,
+                                    label=str(out / "ptfe_paper"))
     for line in table3_lines(contrast):
         print("   " + line)
     sun = (contrast["sun"]["zenith_deg"], contrast["sun"]["azimuth_deg"])

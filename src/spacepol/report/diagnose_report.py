@@ -65,12 +65,12 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     paths = {"base": out / "residuals_base.png", "signatures": out / "signatures.png"}
-    save_figure(residual_figure(base.posterior, base.result), paths["base"])
+    save_figure(residual_figure(base.posterior, base.draws), paths["base"])
     paths["trends"] = out / "residual_trends_base.png"
-    save_figure(residual_trends_figure(analyse(base.posterior, base.result.flat_samples())), paths["trends"])
+    save_figure(residual_trends_figure(analyse(base.posterior, base.draws.flat_samples())), paths["trends"])
     for c in confirmed:
         paths[c["change"]] = out / figure_name(c["change"])
-        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].result), paths[c["change"]])
+        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].draws), paths[c["change"]])
     save_figure(signature_figure(base, [(_name(c), c["signatures"]) for c in confirmed]), paths["signatures"])
     fit = report["fit"]
     sections = [

@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..infer.inference_data import for_storage
 from ..infer.inversion import EXPLAINED_NOISE_RATIO, noise_findings
-from ..io.atomic import atomic_path, save_figure, write_json, write_text
+from ..io.atomic import save_figure, write_text
 from . import html as H
 from ..criticism.residuals import analyse
 from .criticism_figures import residual_trends_figure
@@ -52,7 +51,7 @@ def compare_with_references(result, references: dict) -> dict:
 
 def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = None, references: dict | None = None) -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    posterior, result, summary = inv.posterior, inv.result, inv.summary
+    posterior, result, summary = inv.posterior, inv.draws, inv.summary
     if references:
         summary["references"] = compare_with_references(result, references)
         notes = list(notes or []) + [r["explanation"] for r in summary["references"].values()]
@@ -67,9 +66,7 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
         figures["residuals_mueller.png"] = mueller_residual_figure(posterior, result)
     for name, fig in figures.items():
         save_figure(fig, out / name)
-    with atomic_path(out / "posterior.nc") as tmp:
-        for_storage(inv.idata).to_netcdf(str(tmp))
-    write_json(out / "summary.json", summary)
+    inv.save(out)  # posterior.nc and summary.json
     write_text(out / "report.html", _html(inv, data_path, out, figures, truths, notes or []))
     return summary
 

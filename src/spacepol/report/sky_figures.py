@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Ellipse
 
-from ..sky.projections import PROJECTIONS
+from ..skylight.projections import PROJECTIONS
 
 
 def _grid(proj, n=241):

@@ -1,4 +1,4 @@
-"""Engines: each takes an objective or a posterior, a prior cube and a Generator, and returns a Result.
+"""Engines: each takes an objective or a posterior, a prior cube and a Generator, and returns an EngineResult.
 
 ``optimize(method, ...)`` dispatches the method names of DESIGN.md: ``ga``, ``de``,
 ``nlopt:ALGO`` (and ``emcee`` through :mod:`.emcee_sampler`).

@@ -8,12 +8,12 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from .. import local_search
-from ..result import History, Result
+from ..engine_result import EngineResult, History
 
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,
            popsize: int = 15, tol: float = 1e-8, seed: int | None = None, polish: bool = True,
-           seeds=None, polish_ftol: float | None = None) -> Result:
+           seeds=None, polish_ftol: float | None = None) -> EngineResult:
     """``seeds``: parameter vectors (S, D) placed in the initial population (DE is elitist, so the
     result is never worse than the best of them); ``polish_ftol``: the closing polish's stopping tolerance
     (``local_search._lbfgsb``)."""

@@ -6,7 +6,7 @@
 * Space: the walkers move in the logit of each prior's CDF (``infer.sampling_space``), where the
   declared priors are kept exactly and the wedge DOP leaves between k_s and rho_d is a straight band,
   except parameters whose posterior reaches a prior bound (a dielectric's k near 0); the chain file holds those
-  coordinates (and says which), the Result the declared parameters. On the 84-point DOP set tau fell from
+  coordinates (and says which), the EngineResult the declared parameters. On the 84-point DOP set tau fell from
   81-99 to ~30 steps (``benchmarks/inversion_speed.py``).
 * Moves: differential evolution (80 %) and DE snooker (20 %): DE moves follow the long ridges that
   DOP-only data leave (k_s against rho_d); the snooker keeps a walker from staying stuck on one. The snooker
@@ -37,7 +37,7 @@ import emcee
 import numpy as np
 
 from ..buffered_backend import BufferedHDFBackend
-from ..result import Result
+from ..engine_result import EngineResult
 from ..sampling_space import SamplingSpace, reaching_a_bound
 from .snooker import DESnookerMove
 
@@ -149,7 +149,7 @@ def _tau_at(sampler, iteration: int, space) -> np.ndarray:
 def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None, max_steps: int = 20000,
                  tau_multiple: float = 50.0, check_every: int = 500, min_steps: int = 1000,
                  backend_path=None, progress: bool = True, model_name: str = "", seed: int | None = None,
-                 initial=None, rhat_target: float = RHAT_TARGET, ess_target: float = ESS_TARGET, space=None) -> Result:
+                 initial=None, rhat_target: float = RHAT_TARGET, ess_target: float = ESS_TARGET, space=None) -> EngineResult:
     """``space``: the coordinates the walkers move in (default ``SamplingSpace``, the logit of each prior's CDF;
     ``DeclaredSpace`` is the declared parameters, the baseline of ``benchmarks/inversion_speed.py``)."""
     from ..chain_file import chain_iterations, random_state_readable, replace_random_state
@@ -269,7 +269,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     }
     if start_search is not None:
         info["start_search"] = start_search
-    return Result(
+    return EngineResult(
         method="emcee", model=model_name, names=list(posterior.names),
         best=dict(zip(posterior.names, map(float, best))), objective=float(-log_prob[flat_i]),
         objective_name="negative_log_posterior", n_evaluations=int(sampler.iteration * walkers),

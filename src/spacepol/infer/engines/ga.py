@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from ..result import History, Result
+from ..engine_result import EngineResult, History
 
 
 def _decode(chromosomes, bits):
@@ -29,7 +29,7 @@ def _decode(chromosomes, bits):
 
 def run_ga(objective, rng: np.random.Generator, model_name: str = "", bits: int = 16, population: int = 100,
            p_crossover: float = 0.02, p_mutation: float = 0.02, max_generations: int = 100,
-           tolerance: float = 1e-3, n_replace: int = 20, seed: int | None = None) -> Result:
+           tolerance: float = 1e-3, n_replace: int = 20, seed: int | None = None) -> EngineResult:
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim
     history = History()

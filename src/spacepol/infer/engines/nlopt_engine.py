@@ -8,7 +8,7 @@ import nlopt
 import numpy as np
 
 from ...errors import UnknownNameError
-from ..result import History, Result
+from ..engine_result import EngineResult, History
 
 NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
 
@@ -22,7 +22,7 @@ def check_algorithm(algorithm: str) -> int:
 
 
 def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: str = "",
-              max_evaluations: int = 20000, ftol_rel: float = 1e-10, seed: int | None = None) -> Result:
+              max_evaluations: int = 20000, ftol_rel: float = 1e-10, seed: int | None = None) -> EngineResult:
     code = check_algorithm(algorithm)
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim

@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..differentiable import log_likelihood_function
-from ..result import Result
+from ..engine_result import EngineResult
 from ..sampling_space import SamplingSpace
 from .emcee_sampler import ESS_TARGET, RHAT_TARGET
 
@@ -49,7 +49,7 @@ def _block(mcmc, fields):
 def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: int = 500, draws: int = 500,
                 max_draws: int = 8000, target_accept: float = 0.8, initial=None, progress: bool = True,
                 model_name: str = "", seed: int | None = None, rhat_target: float = RHAT_TARGET,
-                ess_target: float = ESS_TARGET, space=None) -> Result:
+                ess_target: float = ESS_TARGET, space=None) -> EngineResult:
     """``space``: the coordinates the chains move in (default: the logit space, every parameter)."""
     from numpyro.infer import MCMC, NUTS
 
@@ -80,7 +80,7 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
         mcmc.run(mcmc.post_warmup_state.rng_key, extra_fields=fields)
         blocks.append(_block(mcmc, fields))
     extra = {f: np.concatenate([b[1][f] for b in blocks], axis=1) for f in fields}
-    z_draws = z.transpose(1, 0, 2)  # (draws, chains, D), the Result's layout
+    z_draws = z.transpose(1, 0, 2)  # (draws, chains, D), the EngineResult's layout
     log_prob = space.log_posterior_theta(z_draws, -extra["potential_energy"].T)
     samples = space.to_theta(z_draws)
     best_i = np.unravel_index(np.argmax(log_prob), log_prob.shape)
@@ -91,7 +91,7 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
         "leapfrog_per_draw": float(extra["num_steps"].mean()), "divergences": int(extra["diverging"].sum()),
         "space": space.name, "sampler": "nuts",
     }
-    return Result(
+    return EngineResult(
         method="nuts", model=model_name, names=list(posterior.names),
         best=dict(zip(posterior.names, map(float, samples[best_i]))), objective=float(-log_prob[best_i]),
         objective_name="negative_log_posterior", n_evaluations=leapfrogs, seconds=time.perf_counter() - start,

@@ -1,0 +1,450 @@
+"""spacepol from Python: every command of ``invert-mcmc`` is a call here first.
+
+    import spacepol
+    data = spacepol.load("data/ptfe/ptfe_mueller_brdf.csv", wavelength_um=0.633, in_plane=True)
+    result = spacepol.invert(data, "paper", seed=0, out="runs/ptfe")   # a Result
+    again = spacepol.Result.load("runs/ptfe")
+    table3 = spacepol.contrast(again)                                  # a Contrast
+
+The functions check their input as the command line does and raise :class:`spacepol.errors.SpacepolError` (one
+line naming what is wrong) where the command line exits with status 2. Nothing here changes a process-wide setting;
+:func:`spacepol.configure_process` opts in to the command line's speed settings.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError, SpacepolError, UnknownNameError
+from .infer.result import Result
+from .io.dataset import Dataset
+from .physics.model import Model
+
+ENGINES = ("emcee", "laplace")
+
+
+def parse_wavelengths(text: str):
+    """``"0.633"`` -> 0.633; ``"0.532,0.633"`` -> [0.532, 0.633]; ``"all"`` -> "all". Each value a finite number > 0."""
+    import math
+
+    if text.strip().lower() == "all":
+        return "all"
+    values = []
+    for item in text.split(","):
+        try:
+            value = float(item.strip())
+        except ValueError:
+            raise ParameterError(f"'{item.strip()}' is not a number") from None
+        if not math.isfinite(value):
+            raise ParameterError(f"'{item.strip()}' is not a finite number")
+        if value <= 0:
+            raise ParameterError(f"{value:g}: must be > 0")
+        values.append(value)
+    return values[0] if len(values) == 1 else values
+
+
+def load(path, wavelength_um=None, in_plane: bool = False) -> Dataset:
+    """The measurements of a CSV or NIST file. A file over several wavelengths needs ``wavelength_um``: one value,
+    a list, ``"all"``, or text as the command line takes it (``"0.532,0.633"``); ``in_plane`` keeps the rows in the
+    plane of incidence."""
+    from .io.measurements import read_measurements
+
+    if isinstance(wavelength_um, str):
+        wavelength_um = parse_wavelengths(wavelength_um)
+    data = read_measurements(path)
+    if data.wavelength_um is not None and len(np.unique(data.wavelength_um)) > 1 and wavelength_um is None:
+        have = ", ".join(f"{w:g}" for w in np.unique(data.wavelength_um))
+        raise SpacepolError(f"{path}: holds several wavelengths ({have} um); choose one with --wavelength-um, "
+                            f"a comma list, or all")
+    if isinstance(wavelength_um, (list, tuple)):
+        data = data.at_wavelengths([float(w) for w in wavelength_um])
+    elif wavelength_um == "all":
+        if data.wavelength_um is None:
+            raise SpacepolError(f"{path}: --wavelength-um all, but the file gives no wavelength")
+    elif wavelength_um is not None:
+        data = data.at_wavelength(float(wavelength_um))
+    return data.in_plane() if in_plane else data
+
+
+def build_model(spec, data: Dataset | None = None, dispersion: dict | str | None = None):
+    """The model named by ``spec`` (an effect list such as ``"paper+lambertian"``, a preset, or a Model). Over the
+    several wavelengths of ``data`` a SpectralModel: n, k per wavelength, or the ``dispersion`` law
+    ({"n": "cauchy"} or ``"n=cauchy"``)."""
+    from .physics.spectral import SpectralModel
+
+    if isinstance(spec, SpectralModel):
+        return spec
+    base = spec if isinstance(spec, Model) else Model.from_string(spec)
+    laws = _dispersion(dispersion)
+    wavelengths = np.unique(data.wavelength_um) if data is not None and data.wavelength_um is not None else []
+    if len(wavelengths) > 1:
+        return SpectralModel(base, wavelengths, laws)
+    if laws:
+        raise ParameterError(f"--dispersion {dispersion}: needs several wavelengths (--wavelength-um all or a list)")
+    return base
+
+
+def _dispersion(value) -> dict:
+    if not value:
+        return {}
+    if isinstance(value, dict):
+        return dict(value)
+    name, sep, law = str(value).partition("=")
+    if not sep or not law:
+        raise ParameterError(f"--dispersion '{value}': write NAME=LAW, e.g. n=cauchy")
+    return {name.strip(): law.strip()}
+
+
+def parse_observables(names) -> list[str] | None:
+    """``"dop,brdf"`` or ``["dop", "brdf"]`` checked against the observable registry; None keeps what the data hold."""
+    if names is None:
+        return None
+    from .observables import ALIASES, OBSERVABLES
+
+    text = names if isinstance(names, str) else ",".join(names)
+    names = [o.strip() for o in text.split(",")]
+    for name in names:
+        if not name:
+            raise ParameterError(f"--observables '{text}': an empty name (use e.g. dop,brdf)")
+        if name not in OBSERVABLES and name not in ALIASES:
+            raise ParameterError(f"--observables '{text}': unknown observable '{name}' (use {', '.join(OBSERVABLES)}; "
+                                 f"q, u name the Stokes pair)")
+        if names.count(name) > 1:
+            raise ParameterError(f"--observables '{text}': '{name}' named twice (each observable counts once)")
+    return names
+
+
+def build_posterior(data: Dataset, model="paper", prior=None, observables=None, dispersion=None, robust: bool = False):
+    """The Posterior (likelihood and priors) of a model on a data set. ``prior``: a prior TOML file or
+    {parameter: Prior}; ``observables``: which observables to fit (default: all the data hold)."""
+    from .infer.posterior import Posterior
+    from .infer.prior_set import read_prior_file
+
+    where = str(prior) if isinstance(prior, (str, Path)) else "priors"
+    overrides = read_prior_file(prior) if isinstance(prior, (str, Path)) else prior
+    return Posterior.build(data, build_model(model, data, dispersion), overrides,
+                           observables=parse_observables(observables), robust=robust, where=where)
+
+
+def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0, out=None, *,
+           observables=None, dispersion=None, walkers: int | None = None, steps: int = 20000, robust: bool = False,
+           restart: bool = False, progress: bool = False, references: dict | None = None) -> Result:
+    """Sample the posterior of ``model`` (an effect list, a preset or a Model) on ``data`` (a Dataset or a file path) and return its Result.
+
+    ``engine``: ``emcee`` (affine-invariant ensemble, the default) or ``laplace`` (a Laplace approximation at the
+    optimum corrected by importance sampling; an error where its weights cannot be trusted). With ``out`` the run is
+    kept in that folder as ``invert-mcmc run`` keeps it: the chain (an interrupted call continues with the same
+    arguments; ``restart`` starts afresh and keeps the old chain aside), posterior.nc, summary.json, figures and
+    report.html. ``references``: {parameter: value} to compare the posterior with (e.g. a known index)."""
+    if engine not in ENGINES:
+        raise UnknownNameError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
+    data = load(data) if isinstance(data, (str, Path)) else data
+    post = build_posterior(data, model, prior, observables, dispersion, robust)
+    from .infer.inversion import check_walkers
+
+    check_walkers(walkers, post.ndim)
+    if references:
+        for name, value in references.items():
+            if name not in post.names:
+                raise ParameterError(f"--reference '{name}={value:g}': '{name}' is not a free parameter "
+                                     f"({', '.join(post.names)})")
+    if out is None:
+        return _sample(post, engine, seed, walkers, steps, None, progress)
+    return _invert_into(Path(out), post, engine, seed, walkers, steps, restart, progress, references)
+
+
+def _sample(post, engine: str, seed: int, walkers, steps: int, chain, progress: bool) -> Result:
+    from .infer.inversion import invert as invert_emcee, invert_laplace
+
+    if engine == "emcee":
+        return invert_emcee(post, seed=seed, walkers=walkers, max_steps=steps, backend_path=chain, progress=progress)
+    from .infer.optimum import find_optimum
+
+    _, centre = find_optimum(post, np.random.default_rng(seed))
+    result = invert_laplace(post, centre, seed=seed)
+    if result is None:
+        raise SpacepolError(f"engine laplace: the Laplace approximation of {post.likelihood.model.name} cannot be trusted "
+                            f"here (its importance weights failed their checks); use engine emcee")
+    return result
+
+
+def _invert_into(out: Path, post, engine, seed, walkers, steps, restart, progress, references) -> Result:
+    from .infer.chain_file import set_aside
+    from .infer.inversion import check_resumable
+    from .io.output import check_output_dir, folder_lock
+    from .report.run_report import write_run_report
+
+    check_output_dir(out)
+    made_folder = not out.exists()
+    chain = out / "chain.h5" if engine == "emcee" else None
+    fresh = chain is None or not chain.exists()
+    with folder_lock(out):  # first: a second run on this folder stops here, before it reads the chain
+        try:
+            if chain is not None and not restart:
+                check_resumable(chain, post, walkers, seed)
+            if progress:
+                lik = post.likelihood
+                print(f"sampling {', '.join(post.names)} from {len(lik.data)} geometries ({', '.join(lik.observables)}), "
+                      f"model {lik.model.name}", file=sys.stderr)
+                if lik.left_out:
+                    print(f"  not fitted: {', '.join(lik.left_out)} ({' and '.join(sorted(set(lik.left_out.values())))} "
+                          f"holds their numbers; --observables chooses)", file=sys.stderr)
+            if restart and chain is not None and (old := set_aside(chain)) is not None and progress:
+                print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
+            result = _sample(post, engine, seed, walkers, steps, chain, progress)
+        except KeyboardInterrupt:
+            raise  # the chain so far is kept: the same call continues it
+        except BaseException:
+            _discard_unstarted(chain, out, fresh or restart, made_folder)
+            raise
+        if progress:
+            print("  writing the report (figures, posterior.nc, summary.json, report.html)", file=sys.stderr)
+        write_run_report(result, out, _data_label(post.likelihood.data), references=references)
+    return result
+
+
+def _data_label(data: Dataset) -> str:
+    return data.source or "data"
+
+
+def _discard_unstarted(chain: Path | None, out: Path, fresh: bool, made_folder: bool) -> None:
+    """A run that failed before its first stored step leaves nothing behind that would block the
+    corrected call (a chain stamped with the failed run's settings would)."""
+    from .infer.chain_file import ChainFileError, chain_iterations
+
+    if chain is not None:
+        try:
+            empty = fresh and chain.exists() and chain_iterations(chain) == 0
+        except ChainFileError:
+            empty = fresh
+        if empty:
+            chain.unlink(missing_ok=True)
+    if made_folder and out.is_dir() and not any(p.name != ".spacepol.lock" for p in out.iterdir()):
+        import shutil
+
+        shutil.rmtree(out, ignore_errors=True)
+
+
+def parameter_values(model, values: dict | None, where: str = "--set") -> dict[str, float]:
+    """``values`` checked against the model's parameters (names and physical bounds) and completed with the
+    model's defaults."""
+    model = build_model(model)
+    checked = {}
+    for name, value in (values or {}).items():
+        param = model.parameter(name)
+        param.check(float(value), where=where)
+        checked[name] = float(value)
+    return {**model.defaults(), **checked}
+
+
+def forward(model, geometry, values: dict | None = None):
+    """The model's Prediction (Stokes vector, DOP, AoP, BRDF, Mueller matrix) at ``geometry`` (a Geometry, a
+    Dataset or a file of geometries) for parameter ``values`` (defaults for the rest). Non-finite or overflowing
+    output is an error naming the values."""
+    from .physics.geometry import Geometry
+
+    model = build_model(model)
+    if isinstance(geometry, (str, Path)):
+        from .io.measurements import read_measurements
+
+        geometry = read_measurements(geometry, require_observable=False)
+    geometry = geometry.geometry if isinstance(geometry, Dataset) else geometry
+    if not isinstance(geometry, Geometry):
+        raise ParameterError("forward: geometry must be a Geometry, a Dataset or a file of geometries")
+    full = parameter_values(model, values)
+    return model.check_plugins(full, geometry).require_finite(values or {}, model.name)
+
+
+def synth(model, values: dict | None = None, geometry=None, *, noise_dop: float = 0.0, noise_brdf: float | None = None,
+          wavelength_um: float | None = None, seed: int = 0, out=None) -> Dataset:
+    """A synthetic data set: the model's DOP at ``geometry`` (a Geometry, a Dataset, a file, or the paper's default
+    grid) with Gaussian noise ``noise_dop`` (absolute, clipped to [0, 1]) and, when ``noise_brdf`` is given, the
+    BRDF with that relative noise. The truth is in ``metadata`` (``truth_NAME``); ``out`` writes it as a CSV."""
+    from .io.measurements import read_measurements, write_table
+    from .physics.geometry import Geometry, default_grid
+
+    model = build_model(model)
+    full = parameter_values(model, values)
+    if noise_dop < 0 or (noise_brdf is not None and noise_brdf < 0):
+        raise ParameterError("noise levels must be >= 0")
+    if isinstance(geometry, (str, Path)):
+        geometry = read_measurements(geometry, require_observable=False)
+    geometry = default_grid() if geometry is None else geometry.geometry if isinstance(geometry, Dataset) else geometry
+    wavelength = geometry.wavelength_um
+    if wavelength_um is not None:
+        wavelength = np.full(geometry.size, float(wavelength_um))
+        geometry = Geometry(geometry.theta_i, geometry.theta_r, geometry.dphi, wavelength)
+    rng = np.random.default_rng(seed)
+    prediction = model.check_plugins(full, geometry).require_finite(values or {}, model.name)
+    columns = {"theta_i": geometry.theta_i, "theta_r": geometry.theta_r, "dphi": geometry.dphi,
+               "dop": np.clip(prediction.dop + rng.normal(0.0, noise_dop, geometry.size), 0.0, 1.0)}
+    if noise_dop > 0:
+        columns["dop_err"] = np.full(geometry.size, noise_dop)
+    if noise_brdf is not None:
+        columns["brdf"] = np.maximum(prediction.brdf * (1.0 + rng.normal(0.0, noise_brdf, geometry.size)), 0.0)
+        if noise_brdf > 0:
+            columns["brdf_err"] = noise_brdf * prediction.brdf
+    if wavelength is not None:
+        columns["wavelength_um"] = np.asarray(wavelength, float)
+    meta = {"source": "spacepol synth", "model": model.name, "seed": seed, "noise_dop": noise_dop,
+            **{f"truth_{k}": v for k, v in full.items()}}
+    if out is not None:
+        write_table(out, columns, meta)
+    return Dataset(**{k: np.asarray(v, float) for k, v in columns.items()}, metadata=meta,
+                   source=str(out) if out is not None else "spacepol synth")
+
+
+@dataclass
+class Contrast:
+    """A run's posterior in a detection scenario (the paper's Table 3 as distributions): ``rows`` per case with
+    the median and 5-95 % interval of target DOP, sky DOP, limiting magnitude and the contrasts; ``material`` (the
+    wavelength and the rule that gave n, k there); ``draws`` {case: {quantity: draws}}; ``content`` is
+    contrast.json's whole record."""
+
+    content: dict
+    draws: dict
+
+    @property
+    def rows(self) -> list[dict]:
+        """One record per scenario case."""
+        return self.content["rows"]
+
+    @property
+    def material(self) -> dict:
+        """The wavelength the target is seen at, the run's wavelengths and the rule that gave n and k there."""
+        return self.content["material"]
+
+    def to_json(self) -> dict:
+        """contrast.json's content."""
+        return self.content
+
+
+def contrast(result: Result, scenario=None, out=None, *, reading: str = "corrected", draws: int = 20000, seed: int = 0,
+             extrapolate: bool = False) -> Contrast:
+    """Propagate a Result's posterior into target DOP, sky DOP, limiting magnitude and contrasts in ``scenario``
+    (a TOML path, a dict laid out as that file, or a Scenario; default the paper's Table 3). Over several wavelengths n and k at the scenario's
+    wavelength come from the Result's own model (dispersion law or interpolation; beyond the measured range only
+    with ``extrapolate``). With ``out`` the files of ``invert-mcmc contrast`` are written there."""
+    from .detect.contrast import contrast_of
+    from .detect.scenario import default_scenario, read_scenario, scenario_from_dict
+
+    if scenario is None:
+        scenario = default_scenario()
+    elif isinstance(scenario, (str, Path)):
+        scenario = read_scenario(scenario)
+    elif isinstance(scenario, dict):
+        scenario = scenario_from_dict(scenario)
+    if out is None:
+        content, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
+        return Contrast(content, per_case)
+    from .io.output import check_output_dir
+    from .report.contrast_report import assumptions, write_contrast_report
+
+    out = check_output_dir(Path(out))
+    content, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
+    write_contrast_report(content, dict(per_case), out, result.summary["model"],
+                          assumptions(result.summary, scenario, content["material"]))
+    return Contrast(content, per_case)
+
+
+def _direction(value) -> tuple[float, float]:
+    """A direction as ``"ZENITH,AZIMUTH"`` text or a pair, in degrees, checked."""
+    text = value if isinstance(value, str) else ",".join(str(v) for v in value)
+    try:
+        zen, az = (float(v) for v in text.split(","))
+    except ValueError:
+        raise ParameterError(f"--direction '{text}': expected ZENITH,AZIMUTH in degrees, e.g. 60,101.5") from None
+    if not 0 <= zen <= 90:
+        raise ParameterError(f"--direction '{text}': zenith angle must lie in [0, 90] deg")
+    if not np.isfinite(az):
+        raise ParameterError(f"--direction '{text}': azimuth {az:g} deg is not a finite number")
+    return zen, az
+
+
+def _finite_number(name: str, value, low: float | None = None) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"--{name} '{value}': not a number") from None
+    if not np.isfinite(number):
+        raise ParameterError(f"--{name} {value}: '{value}' is not a finite number")
+    if low is not None and number < low:
+        raise ParameterError(f"--{name} {number:g}: must be >= {low:g}")
+    return number
+
+
+@dataclass
+class Sky:
+    """The sun and the sky's polarization at a site and time: ``content`` is sky.json's record (sun, site, model,
+    DOP and AoP at each direction, neutral points, projections); ``model`` the sky model, ``sun`` its position."""
+
+    content: dict
+    model: object
+    sun: object
+
+    @property
+    def directions(self) -> list[dict]:
+        """DOP and AoP (deg) at each direction asked for."""
+        return self.content["directions"]
+
+    def to_json(self) -> dict:
+        """sky.json's content."""
+        return self.content
+
+
+def sky(lat_deg, lon_deg, time: str, directions=(), *, model: str = "rayleigh", p_max: float | None = None,
+        delta_deg: float = 20.0, out=None) -> Sky:
+    """The sun (astropy) and the sky's DOP and AoP at a site (degrees, north and east positive) and an ISO 8601 time
+    with its UTC offset. ``directions``: (zenith, azimuth) pairs or ``"ZENITH,AZIMUTH"`` text in degrees, azimuth
+    east of north; ``model``: ``rayleigh`` (P_max default 1) or ``berry-dennis-lee`` (P_max default 0.8, neutral
+    points ``delta_deg`` from the sun). With ``out`` the maps and sky.json are written there."""
+    from .skylight.neutral_points import BerryDennisLeeSky
+    from .skylight.projections import PROJECTIONS, cap_fraction
+    from .skylight.rayleigh import RayleighSky
+    from .skylight.sun import sun_position
+
+    lat, lon = _finite_number("lat", lat_deg), _finite_number("lon", lon_deg)
+    if p_max is not None:
+        p_max = _finite_number("p-max", p_max, 0.0)
+    delta_deg = _finite_number("delta-deg", delta_deg, 0.0)
+    if model not in ("rayleigh", "berry-dennis-lee"):
+        raise UnknownNameError(f"unknown sky model '{model}' (known: rayleigh, berry-dennis-lee)")
+    pairs = [_direction(d) for d in directions]
+    sky_model = (RayleighSky(1.0 if p_max is None else p_max) if model == "rayleigh"
+                 else BerryDennisLeeSky(0.8 if p_max is None else p_max, delta_deg))
+    sun = sun_position(lat, lon, time)
+    s = (sun.zenith_deg, sun.azimuth_deg)
+    content = {
+        "sun": {"zenith_deg": sun.zenith_deg, "azimuth_deg": sun.azimuth_deg, "altitude_deg": sun.altitude_deg,
+                "time_utc": sun.time_utc, "azimuth_convention": "degrees east of north", "refraction": "none"},
+        "site": {"lat_deg": lat, "lon_deg": lon, "time": time},
+        "model": {"name": sky_model.name, "p_max": sky_model.p_max}
+                 | ({"delta_deg": sky_model.delta_deg} if model != "rayleigh" else {}),
+        "aop_frame": "angle of the E-vector from the local meridian (towards the zenith), positive towards increasing azimuth",
+        "sun_below_horizon": bool(sun.zenith_deg > 90),
+        "directions": [{"zenith_deg": z, "azimuth_deg": a, "dop": float(sky_model.dop(z, a, s)),
+                        "aop_deg": float(sky_model.aop(z, a, s))} for z, a in pairs],
+        "projections": {name: {"zenith_30_cap_share_of_map": cap_fraction(p, 30.0),
+                               "max_angular_distortion_deg": float(p.tissot(89.999)["angular_distortion_deg"]),
+                               "areal_scale_at_horizon": float(p.tissot(89.999)["areal_scale"])}
+                        for name, p in PROJECTIONS.items()},
+    }
+    points = {f"target {i + 1}": d for i, d in enumerate(pairs)}
+    if model != "rayleigh":
+        content["neutral_points"] = {k: {"zenith_deg": z, "azimuth_deg": a} for k, (z, a) in sky_model.neutral_points(s).items()}
+        points.update(sky_model.neutral_points(s))
+    if out is not None:
+        from .io.atomic import save_figure, write_json
+        from .io.output import check_output_dir
+        from .report.sky_figures import projection_distortion_figure, sky_maps_figure
+
+        out = check_output_dir(Path(out))
+        out.mkdir(parents=True, exist_ok=True)
+        save_figure(sky_maps_figure(sky_model, s, points), out / "sky_maps.png")
+        save_figure(projection_distortion_figure(), out / "projections.png")
+        write_json(out / "sky.json", content)
+    return Sky(content, sky_model, sun)

@@ -348,7 +348,7 @@ def main(argv=None) -> int:
     if args.hold_index is not None:
         from spacepol.infer.inversion import invert
         from spacepol.infer.posterior import Posterior
-        from spacepol.infer.priors import Fixed
+        from spacepol.priors import Fixed
 
         model = final.posterior.likelihood.model
         pinned = {p.name: Fixed(args.hold_index) for p in final.posterior.priors.parameters

@@ -116,7 +116,7 @@ def test_diagnose_prior_file_applies_to_candidates_and_rejects_unknown_names(tmp
 def test_prior_overrides_reach_the_models_that_have_the_parameter():
     from spacepol.criticism.diagnose import _build, check_prior_names
     from spacepol.errors import SpacepolError
-    from spacepol.infer.priors import Fixed, Uniform
+    from spacepol.priors import Fixed, Uniform
     from spacepol.physics import Model
     from test_residuals import TRUTH, _data
 

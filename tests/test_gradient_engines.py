@@ -6,7 +6,7 @@ import pytest
 from spacepol.infer.differentiable import cube_objective
 from spacepol.infer.objective import NegativeLogPosterior
 from spacepol.infer.posterior import Posterior
-from spacepol.infer.priors import LogUniform, TruncatedNormal, Uniform
+from spacepol.priors import LogUniform, TruncatedNormal, Uniform
 from spacepol.infer.sampling_space import SamplingSpace
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model

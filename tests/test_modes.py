@@ -12,7 +12,7 @@ import pytest
 
 from spacepol.infer.modes import ModeSearch, search_modes
 from spacepol.infer.prior_set import PriorSet
-from spacepol.infer.priors import Uniform
+from spacepol.priors import Uniform
 from spacepol.physics.parameter import Parameter
 
 SEEDS = range(30)

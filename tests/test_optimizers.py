@@ -7,7 +7,7 @@ from spacepol.infer.engines import OPTIMIZERS, optimize
 from spacepol.infer.engines.ga import _decode
 from spacepol.infer.objective import PaperObjective
 from spacepol.infer.prior_set import PriorSet
-from spacepol.infer.priors import Fixed, Uniform
+from spacepol.priors import Fixed, Uniform
 from spacepol.infer.engine_result import EngineResult
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model

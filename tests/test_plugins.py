@@ -57,7 +57,7 @@ def test_entry_point_plugin(tmp_path, monkeypatch):
 
 def test_parameter_collision_raises():
     from spacepol.physics.effects import Effect, Parameter
-    from spacepol.infer.priors import Uniform
+    from spacepol.priors import Uniform
 
     class Clash(Effect):
         name = "clash"

@@ -8,7 +8,7 @@ from spacepol.errors import ParameterError
 from spacepol.infer.likelihood import Likelihood
 from spacepol.infer.posterior import Posterior
 from spacepol.infer.prior_set import PriorSet, read_prior_file
-from spacepol.infer.priors import Fixed, LogUniform, TruncatedNormal, Uniform
+from spacepol.priors import Fixed, LogUniform, TruncatedNormal, Uniform
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 

@@ -9,7 +9,7 @@ import pytest
 
 from spacepol.infer.posterior import Posterior
 from spacepol.infer.profiled import ProfiledPosterior
-from spacepol.infer.priors import Fixed, Uniform
+from spacepol.priors import Fixed, Uniform
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 

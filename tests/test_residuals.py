@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from spacepol.criticism.residuals import analyse, lag1, runs_test, sweeps
+from spacepol.infer.residuals import analyse, lag1, runs_test, sweeps
 from spacepol.infer.engines.emcee_sampler import sample_emcee
 from spacepol.infer.posterior import Posterior
 from spacepol.io.measurements import Dataset
@@ -53,7 +53,7 @@ def test_a_hidden_effect_leaves_structure_and_a_good_model_does_not(hidden, expe
 
 
 def test_too_many_sign_changes_are_called_alternating_not_smooth():
-    from spacepol.criticism.residuals import ResidualReport
+    from spacepol.infer.residuals import ResidualReport
 
     def report(z):
         runs = {"m13": {"runs": 10, "expected": 20.0, "z": z, "p": 1e-6}}

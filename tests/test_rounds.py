@@ -45,7 +45,7 @@ def test_changes_are_additions_slot_replacements_and_removals():
 
 PLUGIN = textwrap.dedent('''
     import numpy as np
-    from spacepol.infer.priors import Uniform
+    from spacepol.priors import Uniform
     from spacepol.physics.effect import Effect
     from spacepol.physics.parameter import Parameter
 

@@ -6,7 +6,7 @@ import pytest
 from spacepol.infer.engines.emcee_sampler import sample_emcee
 from spacepol.infer.posterior import Posterior
 from spacepol.infer.prior_set import PriorSet
-from spacepol.infer.priors import Fixed, Uniform
+from spacepol.priors import Fixed, Uniform
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 

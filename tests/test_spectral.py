@@ -5,7 +5,7 @@ import pytest
 
 from spacepol.infer.inversion import invert
 from spacepol.infer.posterior import Posterior
-from spacepol.infer.priors import Fixed
+from spacepol.priors import Fixed
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 from spacepol.physics.geometry import Geometry

@@ -159,7 +159,7 @@ def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: di
         summary["derived"] = {name: quantile_dict(np.asarray(v, float).ravel()) for name, v in values.items()}
     ident = identifiability(posterior, result)
     summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
-    from ..criticism.residuals import analyse
+    from .residuals import analyse
 
     structure = analyse(posterior, result.flat_samples())
     summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),

@@ -31,7 +31,7 @@ from .differentiable import cube_objective
 from .engines.de import run_de
 from .objective import NegativeLogPosterior
 from .posterior import PinnedPosterior, Posterior
-from .priors import Fixed
+from ..priors import Fixed
 from .profiled import ProfiledPosterior
 
 

@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..io.toml_file import read_toml
 from ..physics.parameter import Parameter
-from .priors import Fixed, LogUniform, Prior, TruncatedNormal, Uniform
+from ..priors import Fixed, LogUniform, Prior, TruncatedNormal, Uniform
 
 _KEYS = {"distribution", "lower", "upper", "mu", "sigma", "fixed"}
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..infer.priors import LogUniform
+from ..priors import LogUniform
 from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
 from .base import ColumnObservable

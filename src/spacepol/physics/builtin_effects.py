@@ -5,7 +5,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from ..infer.priors import Uniform
+from ..priors import Uniform
 from . import facets, fresnel
 from .effect import Context, Effect, Ratio
 from .parameter import Parameter

@@ -178,11 +178,12 @@ class Effect:
         """{parameter: array} in a canonical form free of label swaps (default: as is)."""
         return values
 
-    # lmfit-style composition: effect + effect -> Model
-    def __add__(self, other):
-        from .model import Model
+    # lmfit-style composition: effect + effect -> Model. model.py sets _model_type when it defines Model, so this
+    # module needs no import of the one that builds on it (the physics package imports both)
+    _model_type = None
 
-        return Model([self]) + other
+    def __add__(self, other):
+        return Effect._model_type([self]) + other
 
     def __repr__(self):
         return f"<effect {self.name}>"

@@ -249,5 +249,8 @@ class Model:
         return dop
 
 
+Effect._model_type = Model  # effect + effect -> Model (physics.effect)
+
+
 def build_model(spec: str | Model) -> Model:
     return spec if isinstance(spec, Model) else Model.from_string(spec)

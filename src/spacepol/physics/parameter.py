@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..infer.priors import Fixed, Prior
+from ..priors import Fixed, Prior
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
-from ..infer.priors import Uniform
+from ..priors import Uniform
 from .geometry import Geometry
 from .model import Model, Prediction
 from .parameter import Parameter

@@ -22,7 +22,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from ..infer.priors import Uniform
+from ..priors import Uniform
 from . import fresnel
 from .effect import Context, Effect
 from .parameter import Parameter

@@ -8,7 +8,7 @@ from ..infer.diagnostics import describe_fit, fit_words
 from ..infer.identifiability import bound_finding
 from ..io.atomic import atomic_path, save_figure
 from . import html as H
-from ..criticism.residuals import analyse
+from ..infer.residuals import analyse
 from .criticism_figures import ladder_figure, residual_trends_figure, signature_figure
 from .ladder_report import ladder_table
 from .inversion_figures import residual_figure

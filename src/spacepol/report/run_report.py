@@ -10,7 +10,7 @@ import numpy as np
 from ..infer.inversion import EXPLAINED_NOISE_RATIO, noise_findings
 from ..io.atomic import save_figure, write_text
 from . import html as H
-from ..criticism.residuals import analyse
+from ..infer.residuals import analyse
 from .criticism_figures import residual_trends_figure
 from ..infer.identifiability import bound_finding
 from .inversion_figures import corner_figure, fit_figure, mueller_residual_figure, residual_figure

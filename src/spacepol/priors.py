@@ -14,7 +14,7 @@ import jax.scipy.special
 import numpy as np
 from scipy import special
 
-from ..errors import ParameterError
+from .errors import ParameterError
 
 
 class Prior:

@@ -14,7 +14,7 @@ Hooks are JAX code (they are compiled and evaluated for many parameter sets at o
 import jax.numpy as jnp
 import numpy as np
 
-from spacepol.infer.priors import Uniform
+from spacepol.priors import Uniform
 from spacepol.physics.effects import Effect, Parameter, effect
 
 

@@ -189,13 +189,16 @@ def test_refits_asked_for_are_skipped_only_where_the_optima_already_decide(monke
 def test_a_refit_whose_chain_did_not_converge_is_said_so():
     """``posterior_quality``: trusted importance weights, a converged chain, and (the case diagnose must not hide) a
     chain stopped by its cap before R-hat and ESS reached their targets."""
-    from types import SimpleNamespace
-
     from spacepol.criticism.diagnose import posterior_quality
+    from spacepol.infer.engine_result import EngineResult
+    from spacepol.infer.result import Result
 
     def fit(engine, rhat=None, ess=None, steps=None):
-        return SimpleNamespace(summary={"diagnostics": {"engine": engine, "rhat_max": rhat, "ess_min": ess, "pareto_k": 0.4}},
-                               result=SimpleNamespace(info={"steps": steps}))
+        summary = {"model": "paper", "seed": 0, "sampler": {"steps": steps},
+                   "diagnostics": {"engine": engine, "rhat_max": rhat, "ess_min": ess, "pareto_k": 0.4}}
+        draws = EngineResult(method=engine or "emcee", model="paper", names=[], best={}, objective=0.0, objective_name="",
+                             n_evaluations=0, seconds=0.0, seed=0)
+        return Result(None, draws, None, summary, {}, {})
 
     assert posterior_quality(fit("laplace-is", None, 900.0))["converged"]
     assert posterior_quality(fit(None, 1.004, 650.0, 4000))["converged"]

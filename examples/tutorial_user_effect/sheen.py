@@ -6,7 +6,7 @@ lowers their DOP, which no built-in effect does in that way.
 The hook is JAX code (plain arithmetic here; use ``jax.numpy`` for functions).
 """
 
-from spacepol.infer.priors import Uniform
+from spacepol.priors import Uniform
 from spacepol.physics.effects import Parameter, effect
 
 

@@ -122,12 +122,19 @@ def build_posterior(data: Dataset, model="paper", prior=None, observables=None, 
     """The Posterior (likelihood and priors) of a model on a data set. ``prior``: a prior TOML file or
     {parameter: Prior}; ``observables``: which observables to fit (default: all the data hold)."""
     from .infer.posterior import Posterior
-    from .infer.prior_set import read_prior_file
 
     where = str(prior) if isinstance(prior, (str, Path)) else "priors"
-    overrides = read_prior_file(prior) if isinstance(prior, (str, Path)) else prior
-    return Posterior.build(data, build_model(model, data, dispersion), overrides,
+    return Posterior.build(data, build_model(model, data, dispersion), _prior_overrides(prior),
                            observables=parse_observables(observables), robust=robust, where=where)
+
+
+def _prior_overrides(prior) -> dict | None:
+    """{parameter: Prior} of a prior TOML file, or the mapping given (None: the model's own priors)."""
+    if isinstance(prior, (str, Path)):
+        from .infer.prior_set import read_prior_file
+
+        return read_prior_file(prior)
+    return None if prior is None else dict(prior)
 
 
 def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0, out=None, *,
@@ -448,3 +455,83 @@ def sky(lat_deg, lon_deg, time: str, directions=(), *, model: str = "rayleigh", 
         save_figure(projection_distortion_figure(), out / "projections.png")
         write_json(out / "sky.json", content)
     return Sky(content, sky_model, sun)
+
+
+@dataclass
+class Diagnosis:
+    """What ``diagnose`` found: ``content`` is the JSON record (verdict, conclusion, ranking of every candidate
+    change with delta ELPD-LOO and its standard error, how each refit's posterior was obtained; with rounds the
+    path), ``base`` the Result of the starting model, ``confirmed`` the refitted candidates, ``rungs`` the path of
+    ``rounds`` as ladder rungs (None without rounds)."""
+
+    content: dict
+    base: Result
+    confirmed: list
+    rungs: list | None
+
+    @property
+    def verdict(self) -> str:
+        """The change the data support most, or that none does, in words."""
+        return self.content["verdict"]
+
+    @property
+    def ranking(self) -> list[dict]:
+        """Every candidate change, best first."""
+        return self.content["ranking"]
+
+    def to_json(self) -> dict:
+        """The JSON record ``diagnose --json`` writes."""
+        return self.content
+
+
+def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None, top: int = 3, prior=None,
+             observables=None, dispersion=None, posterior: str = "laplace", seed: int = 0, out=None,
+             json_path=None, wavelength_um=None, in_plane: bool = False) -> Diagnosis:
+    """Which physical effect is missing or wrong: every candidate change (add, remove or replace an effect) is
+    screened and the ``top`` ones refitted and compared by PSIS-LOO. ``rounds``: apply the best change and diagnose
+    again, up to that many times. ``posterior``: ``laplace`` (importance-corrected, emcee where it cannot be
+    trusted) or ``emcee`` for every refit. With ``out`` the figures and report.html are written there, with
+    ``json_path`` the JSON record. ``data``: a Dataset, or a file read (after every other argument is checked) with
+    ``wavelength_um`` and ``in_plane`` as ``load`` reads it."""
+    from .criticism.diagnose import diagnose as run_diagnose
+    from .io.output import check_output_dir, check_output_file
+    from .physics.registry import registry
+
+    if json_path is not None:
+        check_output_file(json_path, "--json")
+    if out is not None:
+        check_output_dir(out)
+    build_model(model)  # a wrong name fails before the data are read
+    overrides = _prior_overrides(prior)
+    for name in candidates or []:
+        registry.get(name)
+    if top < 1:
+        raise ParameterError(f"--top {top}: need at least 1")
+    if posterior not in ("laplace", "emcee"):
+        raise UnknownNameError(f"--posterior {posterior}: unknown (laplace, emcee)")
+    data = load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
+    full_model = build_model(model, data, dispersion)  # over several wavelengths: n, k per wavelength
+    fitted = parse_observables(observables)
+    rng = np.random.default_rng(seed)
+    if rounds:
+        from .criticism.rounds import as_rungs, diagnose_rounds
+
+        content = diagnose_rounds(data, full_model, rng, rounds, seed=seed, observables=fitted, candidates=candidates,
+                                  top=top, priors=overrides, posterior_method=posterior)
+        rungs = as_rungs(content)
+        first = content.pop("_reports")[0]
+        base, confirmed = first["_base"], first["_confirmed"]
+    else:
+        content = run_diagnose(data, full_model, rng, seed=seed, observables=fitted, candidates=candidates, top=top,
+                               priors=overrides, posterior_method=posterior)
+        base, confirmed = content.pop("_base"), content.pop("_confirmed")
+        rungs = None
+    if out is not None:
+        from .report.diagnose_report import write_diagnose_report
+
+        write_diagnose_report(content, base, confirmed, Path(out), _data_label(data), path_rungs=rungs)
+    if json_path is not None:
+        from .io.atomic import write_json
+
+        write_json(json_path, content)
+    return Diagnosis(content, base, confirmed, rungs)

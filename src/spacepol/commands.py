@@ -200,41 +200,14 @@ def compare(args) -> int:
 
 
 def diagnose(args) -> int:
-    from .criticism.diagnose import diagnose as run_diagnose
-    from .io.atomic import write_json
-    from .physics.registry import registry
-    from .report.diagnose_report import significance_statement, write_diagnose_report
+    from .api import diagnose as diagnose_data
+    from .report.diagnose_report import significance_statement
 
-    from .infer.prior_set import read_prior_file
-
-    check_output_file(args.json, "--json")
-    check_output_dir(args.out)
-    build_model(args.model)  # a wrong name fails before the data are read
-    priors = read_prior_file(args.prior) if args.prior else None
-    for name in args.candidates or []:
-        registry.get(name)
-    if args.top < 1:
-        raise ParameterError(f"--top {args.top}: need at least 1")
-    data = load_dataset(args)
-    model = api_model(args.model, data, getattr(args, "dispersion", None))  # over several wavelengths: n, k per wavelength
-    observables = parse_observables(args.observables)
-    rng = np.random.default_rng(args.seed)
-    if args.rounds:
-        from .criticism.rounds import as_rungs, diagnose_rounds
-
-        result = diagnose_rounds(data, model, rng, args.rounds, seed=args.seed, observables=observables,
-                                 candidates=args.candidates, top=args.top, priors=priors, posterior_method=args.posterior)
-        rungs = as_rungs(result)
-        first = result.pop("_reports")[0]
-        report = result
-        base, confirmed = first["_base"], first["_confirmed"]
-    else:
-        report = run_diagnose(data, model, rng, seed=args.seed, observables=observables,
-                              candidates=args.candidates, top=args.top, priors=priors, posterior_method=args.posterior)
-        base, confirmed = report.pop("_base"), report.pop("_confirmed")
-        rungs = None
-    write_diagnose_report(report, base, confirmed, Path(args.out), str(args.data), path_rungs=rungs)
-    write_json(args.json, report)
+    result = diagnose_data(args.data, args.model, rounds=args.rounds, candidates=args.candidates,
+                           top=args.top, prior=args.prior, observables=args.observables,
+                           dispersion=getattr(args, "dispersion", None), posterior=args.posterior, seed=args.seed,
+                           out=args.out, json_path=args.json, wavelength_um=args.wavelength_um, in_plane=args.in_plane)
+    report = result.content
     lead = report["ranking"][0] if report["ranking"] else None
     print(f"verdict: {report['verdict']}" + (f" ({lead['change']}: delta ELPD {lead['delta_elpd']:+.1f} +- "
                                              f"{lead['delta_elpd_se']:.1f})" if lead and lead["delta_elpd"] is not None else ""))

@@ -26,7 +26,6 @@ import numpy as np
 
 from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
-from ..infer.engines.emcee_sampler import ESS_TARGET, RHAT_TARGET
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
 from ..infer.inversion import explains, invert, invert_laplace
@@ -252,16 +251,13 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
 
 
 def posterior_quality(inv) -> dict:
-    """How a refit's posterior was obtained and whether it can be trusted: the engine (laplace-is: trusted weights by
-    construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for, else not converged within its cap)."""
-    d = inv.summary["diagnostics"]
-    engine = d.get("engine") or "emcee"
-    if engine == "laplace-is":
-        return {"engine": engine, "converged": True, "pareto_k": d.get("pareto_k"), "effective_draws": d.get("ess_min")}
-    rhat, ess = d.get("rhat_max"), d.get("ess_min")
-    converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET
-    return {"engine": engine, "converged": bool(converged), "rhat_max": rhat, "ess_min": ess,
-            "steps": inv.draws.info.get("steps")}
+    """How a refit's posterior was obtained and whether it can be trusted (``Result.diagnostics``): the engine
+    (laplace-is: trusted weights by construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for,
+    else not converged within its cap)."""
+    d = inv.diagnostics
+    if d.engine == "laplace-is":
+        return {"engine": d.engine, "converged": True, "pareto_k": d.pareto_k, "effective_draws": d.ess_min}
+    return {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps}
 
 
 def _unconverged(quality: dict) -> str:

@@ -24,8 +24,8 @@ POSTERIOR_FILE = "posterior.nc"
 
 @dataclass(frozen=True)
 class Diagnostics:
-    """How the draws were obtained and whether they can be trusted. MCMC: R-hat <= 1.01 and ESS >= 400 for every
-    parameter and no step cap hit. Laplace-IS: importance weights that passed their Pareto-k and width checks
+    """How the draws were obtained and whether they can be trusted. MCMC: converged when R-hat <= 1.01 and ESS >= 400
+    for every parameter (``capped``: the chain stopped at its step cap before 50 autocorrelation times). Laplace-IS: importance weights that passed their Pareto-k and width checks
     (``pareto_k``; ``ess_min`` is then the effective number of draws)."""
 
     engine: str
@@ -122,13 +122,13 @@ class Result:
     def diagnostics(self) -> Diagnostics:
         """Convergence or importance-weight diagnostics, typed."""
         d, sampler = self.summary.get("diagnostics", {}), self.summary.get("sampler", {})
-        engine = d.get("engine") or self.draws.method
+        engine = d.get("engine") or "emcee"
         capped = bool(sampler.get("capped", False))
         if engine == "laplace-is":
             converged = True  # invert_laplace returns only weights that passed its checks
         else:
             rhat, ess = d.get("rhat_max"), d.get("ess_min")
-            converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET and not capped
+            converged = rhat is not None and ess is not None and rhat <= RHAT_TARGET and ess >= ESS_TARGET
         steps = sampler.get("steps")
         return Diagnostics(engine=engine, converged=bool(converged), rhat_max=_finite_or_none(d.get("rhat_max")),
                            ess_min=_finite_or_none(d.get("ess_min")), tau_max=_finite_or_none(d.get("tau_max")),

@@ -535,3 +535,99 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
 
         write_json(json_path, content)
     return Diagnosis(content, base, confirmed, rungs)
+
+
+@dataclass
+class Ladder:
+    """The rungs of a ladder: one per model, from the start through each change in order, with its fit (ELPD-LOO
+    and its difference to the rung below, reduced chi^2, the noise it infers) and its Result."""
+
+    rungs: list[dict]
+
+    def to_json(self) -> list[dict]:
+        """The rungs as ``ladder.json`` holds them (without the Results)."""
+        return [{k: v for k, v in rung.items() if not k.startswith("_")} for rung in self.rungs]
+
+
+def ladder(data, model="paper", changes=(), *, observables=None, dispersion=None, seed: int = 0, out=None,
+           json_path=None, wavelength_um=None, in_plane: bool = False) -> Ladder:
+    """Fit the model and then each change in order (``"lambertian"``, ``"replace shadowing by smith"``,
+    ``"remove body"``): the ladder shows what each change buys. The whole ladder is checked to compose before any
+    fit. With ``out`` the figure, table and ladder.json (or ``json_path``) are written. ``data``: a Dataset, or a file
+    read with ``wavelength_um`` and ``in_plane``."""
+    from .criticism.changes import parse
+    from .criticism.ladder import climb
+    from .io.output import check_output_dir, check_output_file
+
+    if out is not None:
+        check_output_dir(out)
+    if json_path is not None:
+        check_output_file(json_path, "--json")
+    steps = list(changes)
+    if not steps:
+        raise ParameterError("ladder: give at least one --add CHANGE or --replay DIAGNOSE.json")
+    current = build_model(model if isinstance(model, (str, Model)) else model.model)
+    for step in steps:  # check the whole ladder composes before fitting anything
+        current = parse(current, step).model
+    data = load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
+    rungs = climb(data, build_model(model, data, dispersion), steps, seed=seed, observables=parse_observables(observables))
+    if out is not None:
+        from .report.ladder_report import write_ladder_report
+
+        write_ladder_report(rungs, Path(out), json_path)
+    return Ladder(rungs)
+
+
+@dataclass
+class Design:
+    """Which measurements would shrink the worst-measured parameter combination most: ``content`` holds the ridge
+    (its parameters, direction, SD relative to the prior), the greedy picks with the SD after each, the best single
+    measurement per observable and the findings in words."""
+
+    content: dict
+
+    @property
+    def picks(self) -> list[dict]:
+        """The proposed measurements, best first."""
+        return self.content["picks"]
+
+    def to_json(self) -> dict:
+        """``design.json``'s content."""
+        return self.content
+
+
+DESIGN_NOISE = ("dop", "brdf", "mueller")
+
+
+def design(data, model="paper", *, picks: int = 3, noise: dict | None = None, prior=None, observables=None,
+           seed: int = 0, out=None, progress: bool = False) -> Design:
+    """The next measurements to make: at the posterior optimum of ``model`` on ``data``, the Fisher information of
+    every candidate geometry and observable; ``picks`` chosen greedily. ``noise``: {"dop": X, "brdf": REL,
+    "mueller": X} for the candidates (default: the data's own levels)."""
+    from .criticism.design import design as rank_measurements
+    from .infer.optimum import find_optimum
+
+    if out is not None:
+        from .io.output import check_output_dir
+
+        out = check_output_dir(out)
+    noise = dict(noise or {})
+    for name, value in noise.items():
+        if name not in DESIGN_NOISE or not float(value) > 0:
+            raise ParameterError(f"--noise '{name}={value}': expected dop=X, brdf=REL or mueller=X with X > 0")
+    if picks < 1:
+        raise ParameterError(f"--picks {picks}: need at least 1")
+    data = load(data) if isinstance(data, (str, Path)) else data
+    post = build_posterior(data, model, prior, observables)
+    if progress:
+        print(f"design: the optimum of {post.likelihood.model.name} on {len(data)} geometries "
+              f"({', '.join(post.likelihood.observables)}), then the Fisher information of every candidate",
+              file=sys.stderr)
+    _, theta = find_optimum(post, np.random.default_rng(seed))
+    point = {k: float(np.ravel(v)[0]) for k, v in post.priors.to_params(theta[None, :]).items()}
+    content = rank_measurements(post, point, picks=picks, noise=noise)
+    if out is not None:
+        from .report.design_report import write_design_report
+
+        write_design_report(content, out, _data_label(data))
+    return Design(content)

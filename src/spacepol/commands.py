@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from .api import build_model as api_model, parse_observables
 from .errors import ParameterError
 from .io import Dataset, read_measurements, write_table
 from .io.output import check_output_dir, check_output_file
@@ -220,28 +218,20 @@ def diagnose(args) -> int:
 
 
 def ladder(args) -> int:
-    from .criticism.changes import parse
-    from .criticism.ladder import climb
-    from .report.ladder_report import write_ladder_report
+    from .api import ladder as climb_ladder
+    from .report.ladder_report import ladder_table
 
     check_output_dir(args.out)
     if args.json:
         check_output_file(args.json, "--json")
-    model = build_model(args.model)
     steps = list(args.add)
     if args.replay:
-        steps = replay_steps(args.replay, model) + steps
-    if not steps:
-        raise ParameterError("ladder: give at least one --add CHANGE or --replay DIAGNOSE.json")
-    current = model
-    for step in steps:  # check the whole ladder composes before fitting anything
-        current = parse(current, step).model
-    data = load_dataset(args)
-    model = api_model(args.model, data, getattr(args, "dispersion", None))
-    observables = parse_observables(args.observables)
-    rungs = climb(data, model, steps, seed=args.seed, observables=observables)
+        steps = replay_steps(args.replay, build_model(args.model)) + steps
+    result = climb_ladder(args.data, args.model, steps, observables=args.observables,
+                          dispersion=getattr(args, "dispersion", None), seed=args.seed, out=args.out, json_path=args.json,
+                          wavelength_um=args.wavelength_um, in_plane=args.in_plane)
     out = Path(args.out)
-    print("\n".join(write_ladder_report(rungs, out, args.json)))
+    print("\n".join(ladder_table(result.to_json())))
     print(f"wrote {args.json or out / 'ladder.json'}, {out / 'ladder.png'}, {out / 'ladder.md'}")
     return 0
 
@@ -264,17 +254,9 @@ def replay_steps(path, model: Model) -> list[str]:
 
 
 def design(args) -> int:
-    from .criticism.design import design as rank_measurements
-    from .infer.optimum import find_optimum
-    from .report.design_report import write_design_report
+    from .api import design as propose
 
     out = check_output_dir(args.out)
-    data = load_dataset(args)
-    posterior = build_posterior(args, data)
-    print(f"design: the optimum of {posterior.likelihood.model.name} on {len(data)} geometries "
-          f"({', '.join(posterior.likelihood.observables)}), then the Fisher information of every candidate", file=sys.stderr)
-    _, theta = find_optimum(posterior, np.random.default_rng(args.seed))
-    point = {k: float(np.ravel(v)[0]) for k, v in posterior.priors.to_params(theta[None, :]).items()}
     noise = {}
     for item in args.noise:
         name, sep, text = item.partition("=")
@@ -284,9 +266,12 @@ def design(args) -> int:
             raise ParameterError(f"--noise '{item}': expected dop=X, brdf=REL or mueller=X") from None
         if not sep or name.strip() not in ("dop", "brdf", "mueller") or not noise[name.strip()] > 0:
             raise ParameterError(f"--noise '{item}': expected dop=X, brdf=REL or mueller=X with X > 0")
-    report = rank_measurements(posterior, point, picks=args.picks, noise=noise)
-    lines = write_design_report(report, out, args.data)
-    print("\n".join(lines[2:3]))
+    data = load_dataset(args)
+    result = propose(data, args.model, picks=args.picks, noise=noise, prior=args.prior, observables=args.observables,
+                     seed=args.seed, out=out, progress=True)
+    from .report.design_report import design_lines
+
+    print("\n".join(design_lines(result.content, args.data)[2:3]))
     print(f"wrote {out}/design.md, design.json, design.png")
     return 0
 

@@ -26,10 +26,19 @@ def shrink_map_figure(maps: dict, fig=None) -> Figure:
 
 
 def write_design_report(report: dict, out: Path, source: str) -> list[str]:
+    """design.png, design.json and design.md in ``out``; returns design.md's lines."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     save_figure(shrink_map_figure(shrink_maps(report)), out / "design.png")
     write_json(out / "design.json", report)
+    lines = design_lines(report, source)
+    with atomic_path(out / "design.md") as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return lines
+
+
+def design_lines(report: dict, source: str) -> list[str]:
+    """design.md's lines: the findings, the picks as a table and the ridge."""
     lines = [f"# Experiment design for {source}", "", *report["findings"], "",
              "| pick | measurement | noise | ridge sd after (prior units) | shrink |", "|---|---|---|---|---|"]
     for i, p in enumerate(report["picks"], 1):
@@ -39,8 +48,6 @@ def write_design_report(report: dict, out: Path, source: str) -> list[str]:
               + ", ".join(f"{n} {c:+.2f}" for n, c in report["ridge"]["direction"].items() if abs(c) > 1e-3)
               + f" (in prior-sd units); sd before {report['ridge']['sd_relative_to_prior']:.3f} of the prior's.",
               "The factors are a linear (Fisher) prediction at the point; add the measurements and invert again to see the real one."]
-    with atomic_path(out / "design.md") as tmp:
-        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return lines
 
 

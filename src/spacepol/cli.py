@@ -9,6 +9,7 @@ import sys
 
 def _int_at_least(low: int):
     def parse(text: str) -> int:
+        """An argparse type: a whole number >= the bound, else one line naming the value."""
         try:
             value = int(text)
         except ValueError:

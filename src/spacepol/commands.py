@@ -41,6 +41,7 @@ def _prediction_columns(geometry: Geometry, prediction) -> dict:
 
 
 def forward(args) -> int:
+    """``invert-mcmc forward``: the model's Stokes vector, DOP, AoP and BRDF at a file's geometries, as a CSV."""
     from .api import forward as predict
 
     check_output_file(args.out)
@@ -58,6 +59,8 @@ def forward(args) -> int:
 
 
 def synth(args) -> int:
+    """``invert-mcmc synth``: a synthetic data set from a model with Gaussian noise, as a CSV with its truth in the
+    metadata."""
     from .api import synth as synthesise
 
     check_output_file(args.out)
@@ -70,6 +73,7 @@ def synth(args) -> int:
 
 
 def effects(args) -> int:
+    """``invert-mcmc effects``: every registered effect with its parameters, priors, slot, twins and reciprocity."""
     from .physics.effects import PRESETS, registry
     import textwrap
 
@@ -98,6 +102,7 @@ def effects(args) -> int:
 
 
 def demo(args) -> int:
+    """``invert-mcmc demo``: the whole chain on bundled data, report in ``--out``."""
     from .report.demo import run_demo
 
     check_output_dir(args.out)
@@ -134,6 +139,7 @@ def parse_references(items) -> dict[str, float]:
 
 
 def run(args) -> int:
+    """``invert-mcmc run``: ``api.invert`` with the run's report; prints the findings and the convergence figures."""
     from .api import invert
 
     check_output_dir(args.out)  # before the data are read
@@ -156,6 +162,8 @@ def run(args) -> int:
 
 
 def optimize(args) -> int:
+    """``invert-mcmc optimize``: one optimizer (``ga``, ``de``, ``nlopt:ALGO``) or emcee on the paper's objective;
+    prints its Result as JSON."""
     import json
 
     from .infer.engines import optimize as run_optimizer
@@ -184,6 +192,7 @@ def optimize(args) -> int:
 
 
 def compare(args) -> int:
+    """``invert-mcmc compare``: several engines and seeds on the same posterior; figures and table in ``--out``."""
     from .report.compare import run_comparison
 
     from .infer.engines import check_method
@@ -198,6 +207,7 @@ def compare(args) -> int:
 
 
 def diagnose(args) -> int:
+    """``invert-mcmc diagnose``: ``api.diagnose`` and its verdict, conclusion and significance in words."""
     from .api import diagnose as diagnose_data
     from .report.diagnose_report import significance_statement
 
@@ -218,6 +228,7 @@ def diagnose(args) -> int:
 
 
 def ladder(args) -> int:
+    """``invert-mcmc ladder``: ``api.ladder`` over ``--add`` changes (after a ``--replay`` path) and its table."""
     from .api import ladder as climb_ladder
     from .report.ladder_report import ladder_table
 
@@ -254,6 +265,7 @@ def replay_steps(path, model: Model) -> list[str]:
 
 
 def design(args) -> int:
+    """``invert-mcmc design``: ``api.design`` with ``--noise`` levels; prints the first finding."""
     from .api import design as propose
 
     out = check_output_dir(args.out)
@@ -277,6 +289,7 @@ def design(args) -> int:
 
 
 def batch(args) -> int:
+    """``invert-mcmc batch``: every set of a manifest; exit status 1 when any set failed."""
     from .batch import run_batch
 
     rows = run_batch(args.manifest, args.out, executor=args.executor, scheduler=args.scheduler, workers=args.workers,
@@ -288,6 +301,7 @@ def batch(args) -> int:
 
 
 def sky(args) -> int:
+    """``invert-mcmc sky``: ``api.sky`` and its figures; prints the sun and the sky's DOP and AoP at each direction."""
     from .api import sky as sky_of
 
     check_output_dir(args.out)
@@ -305,6 +319,8 @@ def sky(args) -> int:
 
 
 def contrast(args) -> int:
+    """``invert-mcmc contrast``: a run folder's Result through a scenario (``api.contrast``); prints Table 3 as
+    distributions."""
     from .detect.scenario import default_scenario, read_scenario
     from .report.contrast_report import make_contrast_report, table3_lines
 

@@ -15,6 +15,8 @@ def data_dir() -> Path:
 
 
 def bundled(*parts: str) -> Path:
+    """A file shipped in the package's data (``bundled("ptfe", "ptfe_mueller_brdf.csv")``); one line when it is
+    missing."""
     path = data_dir().joinpath(*parts)
     if not path.exists():
         from .errors import SpacepolError

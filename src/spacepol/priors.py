@@ -181,10 +181,12 @@ class Fixed(Prior):
 
     @property
     def lower(self):  # type: ignore[override]
+        """The fixed value (a point prior's lower bound)."""
         return self.value
 
     @property
     def upper(self):  # type: ignore[override]
+        """The fixed value (a point prior's upper bound)."""
         return self.value
 
     @property

@@ -50,6 +50,7 @@ def _collect(futures: dict, as_completed, on_done) -> None:
 
 
 def run_local(jobs, out: str, workers: int, on_done) -> None:
+    """Run the jobs on a local pool of ``workers`` spawned processes; ``on_done(row)`` as each finishes."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
@@ -62,6 +63,8 @@ def run_local(jobs, out: str, workers: int, on_done) -> None:
 
 
 def run_dask(jobs, out: str, workers: int, scheduler: str | None, on_done) -> None:
+    """Run the jobs on a Dask cluster (``scheduler``: its address; None starts a local one with ``workers``);
+    ``on_done(row)`` as each finishes."""
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:

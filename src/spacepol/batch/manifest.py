@@ -38,6 +38,8 @@ class BatchJob:
 
 
 def read_manifest(path) -> list[BatchJob]:
+    """The jobs of a manifest CSV (``id``, ``data`` and the optional columns), checked row by row: one line naming the
+    row and column that is wrong."""
     path = Path(path)
     if not path.is_file():
         raise InputFileError(path, "is a folder, not a manifest" if path.is_dir() else "file not found")

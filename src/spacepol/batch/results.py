@@ -30,6 +30,8 @@ def _number(value) -> str:
 
 
 def write_results(path, rows: list[dict]) -> None:
+    """``results.csv`` atomically: per set its id, status, seconds, each parameter's median and interval, R-hat, ESS
+    and the error line."""
     parameters = []
     for row in rows:
         for key in row:

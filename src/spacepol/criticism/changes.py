@@ -25,6 +25,7 @@ class Change:
 
     @property
     def label(self) -> str:
+        """The change in words, as diagnose and ladder name it ("add lambertian", "replace shadowing by smith")."""
         if self.kind == "replace":
             return f"replace {self.replaced} by {self.effect}"
         return f"{self.kind} {self.effect}"

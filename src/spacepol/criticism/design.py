@@ -36,6 +36,7 @@ class Candidate:
     noise: float
 
     def describe(self) -> str:
+        """The candidate measurement in words (observable and angles)."""
         what = {"dop": "DOP", "brdf": "BRDF", "mueller": "the Mueller matrix"}[self.observable]
         return f"{what} at theta_i {self.theta_i:g}, theta_r {self.theta_r:g}, dphi {self.dphi:g} deg"
 

@@ -80,10 +80,12 @@ class Case:
 
     @property
     def spec(self) -> str:
+        """The model that renders the case: the base model plus the hidden effect."""
         return BASE if self.effect is None else f"{BASE}+{self.effect}"
 
     @property
     def truth(self) -> dict:
+        """Every parameter's true value: the model's defaults, the material's and the hidden effect's values."""
         model = Model.from_string(self.spec)
         names = {p.name for p in model.parameters}
         return {**model.defaults(), **{k: v for k, v in MATERIALS[self.material].items() if k in names}, **self.hidden}
@@ -107,6 +109,8 @@ def suite(effects=None, n_null: int = 8, seed: int = 0) -> list[Case]:
 
 
 def measurement(case: Case, noisy: bool = True) -> Dataset:
+    """The case's data set: its model's DOP and BRDF at the case's sampling, with the case's noise unless ``noisy`` is
+    False."""
     g = sampling(case.sampling)
     pred = Model.from_string(case.spec).evaluate(case.truth, g)
     rng = np.random.default_rng(case.seed)
@@ -149,6 +153,8 @@ def covered(effect: str, inversion, truth: dict) -> dict[str, bool]:
 
 
 def score(case: Case, report: dict) -> dict:
+    """One row of the validation table: the verdict, whether it named the hidden effect (or none for a null case), and
+    the fit after the change."""
     lead = report["ranking"][0] if report["ranking"] else {}
     named = [report["verdict"]] + lead.get("tied_with", [])
     out = {"label": case.label, "effect": case.effect or "none", "material": case.material, "sampling": case.sampling,
@@ -164,6 +170,7 @@ def score(case: Case, report: dict) -> dict:
 
 
 def run_case(case: Case, seed: int = 0, progress: bool = False) -> dict:
+    """Render the case, diagnose it from the base model and score the verdict."""
     rng = np.random.default_rng(case.seed)
     if case.effect is not None:
         case.size = effect_size(case, rng)
@@ -172,6 +179,8 @@ def run_case(case: Case, seed: int = 0, progress: bool = False) -> dict:
 
 
 def summarise(rows: list[dict], threshold: float = 3.0) -> dict:
+    """The suite's figures: how often the hidden effect is named (all cases and those above ``threshold`` in size),
+    false alarms on null cases, interval coverage after the change."""
     hidden = [r for r in rows if r["effect"] != "none"]
     big = [r for r in hidden if r["size"] >= threshold]
     nulls = [r for r in rows if r["effect"] == "none"]

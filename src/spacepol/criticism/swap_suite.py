@@ -41,20 +41,25 @@ class SwapCase:
 
     @property
     def spec(self) -> str:
+        """The model that renders the case: the swap suite's base plus the hidden effect."""
         return SWAP_BASE if self.effect is None else f"{SWAP_BASE}+{self.effect}"
 
     @property
     def hidden(self) -> dict:
+        """The hidden effect's own parameter values (empty for a null case)."""
         return {} if self.effect is None else dict(HIDDEN_VALUES[self.effect][1])
 
     @property
     def truth(self) -> dict:
+        """Every parameter's true value: the model's defaults, the material's and the hidden effect's values."""
         model = Model.from_string(self.spec)
         names = {p.name for p in model.parameters}
         return {**model.defaults(), **{k: v for k, v in MATERIALS[self.material].items() if k in names}, **self.hidden}
 
 
 def swap_suite(seed: int = 0) -> list[SwapCase]:
+    """The suite's cases: every hidden effect (and none) twice, materials, noise levels and samplings alternating,
+    seeds from ``seed``."""
     cases = []
     for i, effect in enumerate(EFFECTS):
         for j in range(2):
@@ -64,6 +69,7 @@ def swap_suite(seed: int = 0) -> list[SwapCase]:
 
 
 def measurement(case: SwapCase) -> Dataset:
+    """The case's data set: DOP and BRDF of its model at its sampling with its noise."""
     g = sampling(case.sampling)
     pred = Model.from_string(case.spec).evaluate(case.truth, g)
     rng = np.random.default_rng(case.seed)
@@ -89,6 +95,8 @@ def shadowing_swapped(rounds: list[dict], final_model: str) -> bool:
 
 
 def score(case: SwapCase, result: dict) -> dict:
+    """One row of the swap suite's table: the path diagnose took, whether it found the hidden effect (or added nothing
+    for a null case), and the final fit."""
     path = [r["change"] for r in result["rounds"][1:]]
     final = result["rounds"][-1]
     tied = {t for report in result["_reports"] for entry in report["ranking"][:1] for t in entry.get("tied_with", [])}
@@ -143,6 +151,7 @@ def swap_figure(rows: list[dict], ax=None) -> Figure:
 
 
 def run_swap_case(case: SwapCase, rounds: int = 4, seed: int = 0, progress: bool = False) -> dict:
+    """Render the case and run ``diagnose --rounds`` from the paper's wrong model; the scored row."""
     rng = np.random.default_rng(case.seed)
     result = diagnose_rounds(measurement(case), Model.from_string(START), rng, rounds, seed=seed, progress=progress)
     return score(case, result)

@@ -24,11 +24,13 @@ THETA_R_GRID = 81
 
 
 def interval(x) -> dict:
+    """Median and 5-95 % interval of draws."""
     q = np.percentile(np.asarray(x, float), [5, 50, 95])
     return {"median": float(q[1]), "q05": float(q[0]), "q95": float(q[2])}
 
 
 def sky_model(scenario, p_max):
+    """The scenario's sky model (Rayleigh or Berry-Dennis-Lee) with this P_max."""
     if scenario.sky["model"] == "berry-dennis-lee":
         return BerryDennisLeeSky(p_max, scenario.sky["delta_deg"])
     return RayleighSky(p_max)
@@ -117,6 +119,7 @@ def _draw_sky(scenario, case, sun, rng, draws, fixed_p_max=None):
 
 
 def case_rows(p_target, p_sky, scenario, reading):
+    """Target DOP, sky DOP, limiting magnitude and the two contrasts for draws of target and sky DOP."""
     inst = scenario.instrument
     m_lim = R.limiting_magnitude(p_target, inst, reading)
     return {"target_dop": p_target, "sky_dop": p_sky, "limiting_magnitude": m_lim,

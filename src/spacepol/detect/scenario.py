@@ -113,6 +113,7 @@ def _section(where: str, table: dict, specs: dict, defaults: bool = True) -> dic
 
 
 def default_scenario() -> Scenario:
+    """The paper's scenario: its section 4 site and time, Table 2's instrument and Table 3's cases."""
     return Scenario(*(_section(name, {}, specs) for name, specs in SECTIONS.items()), cases=[dict(c) for c in PAPER_CASES])
 
 

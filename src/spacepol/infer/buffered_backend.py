@@ -16,6 +16,10 @@ import numpy as np
 
 
 class BufferedHDFBackend(emcee.backends.HDFBackend):
+    """emcee's HDF5 backend that writes every ``every`` steps instead of each one (an HDF5 write per step cost more
+    than a step); ``flush`` writes what is pending, and every read flushes first, so a resumed chain is the
+    same."""
+
     def __init__(self, filename, name="mcmc", every: int = 100, **kwargs):
         super().__init__(filename, name=name, **kwargs)
         self.every = every
@@ -49,18 +53,22 @@ class BufferedHDFBackend(emcee.backends.HDFBackend):
     # everything that reads the file sees the waiting steps too
     @property
     def iteration(self):
+        """Steps stored so far, the pending ones included."""
         return super().iteration + len(self._pending)
 
     @property
     def accepted(self):
+        """Accepted proposals per walker (after writing what is pending)."""
         self.flush()
         return super().accepted
 
     @property
     def random_state(self):
+        """The random state after the latest step, pending or stored."""
         return self._pending[-1][4] if self._pending else super().random_state
 
     def get_value(self, name, flat=False, thin=1, discard=0):
+        """A stored array (chain, log_prob, ...) after writing what is pending; emcee's arguments."""
         self.flush()
         return super().get_value(name, flat=flat, thin=thin, discard=discard)
 

@@ -58,6 +58,7 @@ class History:
         self.points: list[tuple[int, float]] = []
 
     def record(self, x, values):
+        """Count the evaluations of ``values`` at points ``x`` and keep the best so far."""
         values = np.atleast_1d(values)
         x = np.atleast_2d(x)
         self.evaluations += len(values)
@@ -67,6 +68,7 @@ class History:
         self.points.append((self.evaluations, self.best))
 
     def as_array(self):
+        """(evaluations so far, best objective so far) per record, as a (k, 2) array."""
         return np.array(self.points, dtype=float)
 
     def to_result(self, method, objective, model_name, seconds, seed, info) -> EngineResult:

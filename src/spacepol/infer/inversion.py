@@ -25,6 +25,8 @@ from .sampling_space import SamplingSpace
 
 
 def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.family) -> str:
+    """A short hash of what decides a chain (model, priors, observables, data, walkers, seed, sampling space): a stored
+    chain resumes only under the same fingerprint."""
     lik = posterior.likelihood
     h = hashlib.sha256()
     h.update(lik.model.name.encode())

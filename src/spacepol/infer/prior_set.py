@@ -84,6 +84,8 @@ def prior_from_nk_table(name: str, table: dict, where: str) -> Prior:
 
 
 def prior_from_table(name: str, table: dict, where: str) -> Prior:
+    """The Prior of one ``[name]`` table of a prior file (``uniform``, ``log_uniform``, ``normal``, ``fixed``, bounds,
+    or an ``nk_table``); unknown keys and impossible values are one line naming ``where``."""
     if "nk_table" in table:
         return prior_from_nk_table(name, table, where)
     unknown = set(table) - _KEYS
@@ -125,6 +127,7 @@ def _float(value, name, key, where):
 
 
 def read_prior_file(path) -> dict[str, Prior]:
+    """{parameter: Prior} of a prior TOML file, each table checked."""
     path = Path(path)
     data = read_toml(path, "prior")
     priors = {}

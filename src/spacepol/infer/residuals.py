@@ -31,6 +31,8 @@ class ResidualReport:
     trends: dict  # observable -> {variable: {"rho", "p"}}
 
     def findings(self, alpha: float = 0.01) -> list[str]:
+        """The structure in words: sweeps whose residuals change sign too rarely, lag-1 correlation and trends
+        significant at ``alpha``."""
         out = []
         for o in self.observables:
             r = self.runs[o]
@@ -86,6 +88,8 @@ def runs_test(residuals, groups) -> dict:
 
 
 def lag1(residuals, groups) -> float:
+    """Lag-1 autocorrelation of residuals along the sweeps ``groups`` (index arrays in sweep order); NaN without a
+    sweep of three or more."""
     pairs = [(residuals[idx][:-1], residuals[idx][1:]) for idx in groups if len(idx) > 2]
     if not pairs:
         return float("nan")
@@ -97,6 +101,8 @@ def lag1(residuals, groups) -> float:
 
 
 def analyse(posterior, samples) -> ResidualReport:
+    """The ResidualReport of the posterior-median fit: standardised residuals per observable, runs test and lag-1
+    correlation along the theta_r sweeps, rank correlations with the angles and the DOP level."""
     data = posterior.likelihood.data
     mu, scale = median_fit(posterior, samples)
     res = {o: posterior.likelihood.standardise(o, mu[o], scale[o]) for o in posterior.likelihood.observables}

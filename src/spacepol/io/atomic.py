@@ -59,11 +59,13 @@ def _jsonable(value):
 
 
 def write_json(path, data) -> None:
+    """Write ``data`` as indented JSON (NumPy values converted), atomically."""
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(_jsonable(data), indent=2) + "\n", encoding="utf-8")
 
 
 def write_text(path, text: str) -> None:
+    """Write ``text`` as UTF-8, atomically."""
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
 

@@ -42,10 +42,12 @@ class Dataset:
     # Normalised Stokes parameters q = S1/S0, u = S2/S0 (s-polarized light has q > 0).
     @property
     def q(self):
+        """Normalised Stokes q = S1/S0 per row (None without Stokes columns)."""
         return None if self.stokes is None else self.stokes[1] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
 
     @property
     def u(self):
+        """Normalised Stokes u = S2/S0 per row (None without Stokes columns)."""
         return None if self.stokes is None else self.stokes[2] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
 
     q_err = None
@@ -53,12 +55,14 @@ class Dataset:
 
     @property
     def geometry(self) -> Geometry:
+        """The rows' geometry (angles and wavelength), computed once."""
         if not hasattr(self, "_geometry"):
             self._geometry = Geometry(self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
         return self._geometry
 
     @property
     def observables(self) -> list[str]:
+        """The observables the data hold: dop, brdf, aop, stokes, mueller."""
         names = [n for n in ("dop", "brdf", "aop") if getattr(self, n) is not None]
         if self.stokes is not None:
             names.append("stokes")
@@ -96,6 +100,7 @@ class Dataset:
         return keep
 
     def at_wavelength(self, wavelength_um: float, tolerance_um: float = 1e-4) -> "Dataset":
+        """The rows at one wavelength (it must be present); the metadata record it."""
         out = self.select(self._rows_at(wavelength_um, tolerance_um))
         out.metadata = {**self.metadata, "wavelength_um": wavelength_um}
         return out

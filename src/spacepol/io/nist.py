@@ -23,6 +23,7 @@ _RATIO_NAMES = [f"m{i}{j}" for i in range(1, 5) for j in range(1, 5)][1:]
 
 
 def is_nist_header(header) -> bool:
+    """True for the header of NIST's Mueller BRDF files (lambda, thetai, phii, ... and 16 ratio columns)."""
     lowered = [h.lower() for h in header]
     return len(lowered) >= 21 and lowered[0] == "lambda" and lowered[1] == "thetai"
 
@@ -33,6 +34,8 @@ def _wrap_deg(angle):
 
 def read_nist_rows(path, header, lines, header_line, meta):
 
+    """The rows of a NIST Mueller BRDF file as a Dataset: angles converted to the spacepol convention, the Mueller
+    matrix from fr11 and the ratios, each value checked."""
     if len(header) != 21:
         raise InputFileError(path, f"NIST Mueller layout needs 21 columns, header has {len(header)}", line=header_line)
     names = ["lambda", "thetai", "phii", "thetar", "phir", "fr11"] + _RATIO_NAMES

@@ -9,6 +9,7 @@ from ..errors import SpacepolError
 
 
 def read_toml(path, what: str) -> dict:
+    """The tables of a TOML file; a missing or malformed file is one line naming it and ``what`` it should hold."""
     path = Path(path)
     if not path.is_file():
         raise SpacepolError(f"{path}: {what} file not found")

@@ -35,6 +35,7 @@ class Specular(Effect):
     branches = ({"k": 0.0},)  # dielectrics (PTFE, paints, glass): k < 0.05 is 0.25 % of the default k prior
 
     def distribution(self, ctx: Context):
+        """The facet slope distribution at the half-vector: Beckmann (or GGX, anisotropic when configured)."""
         geo = ctx.geometry
         if ctx.anisotropic_slopes is not None:
             sx, sy, psi = ctx.anisotropic_slopes

@@ -61,6 +61,7 @@ class Context:
         return self.params[name]
 
     def zeros(self):
+        """An all-zero total of the model's shape: (4, 4, ...) for Mueller matrices, (4, ...) for Stokes vectors."""
         lead = (4, 4) if self.mueller else (4,)
         return jnp.zeros(lead + self.shape)
 
@@ -108,6 +109,7 @@ class Ratio:
         return Ratio([row + lobe[j] * self.denominator for j, row in enumerate(self.rows)], self.denominator)
 
     def broadcast_rows(self, shape) -> list:
+        """Each row of the numerator broadcast to ``shape``."""
         return [jnp.broadcast_to(row, shape) for row in self.rows]
 
     def divided(self, shape):
@@ -124,6 +126,7 @@ class DepolarizedLobe:
     def add_to(self, total, mueller: bool):
         # added through a one-hot (4, 4) or (4,) pattern, not written into M00 in place: an in-place update
         # made XLA copy every element of the total out again for the likelihood's reductions
+        """``total`` plus this lobe's intensity in S0 (M00)."""
         pattern = np.zeros((4, 4) if mueller else (4,))
         pattern.flat[0] = 1.0
         return total + jnp.asarray(self.intensity) * pattern.reshape(pattern.shape + (1,) * (jnp.ndim(total) - pattern.ndim))
@@ -178,6 +181,11 @@ class Effect:
         """{parameter: array} in a canonical form free of label swaps (default: as is)."""
         return values
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if not cls.__dict__.get("__doc__") and cls.__dict__.get("description"):
+            cls.__doc__ = f"The ``{cls.name}`` effect. {cls.description}"  # one text for help(), docs and `effects`
+
     # lmfit-style composition: effect + effect -> Model. model.py sets _model_type when it defines Model, so this
     # module needs no import of the one that builds on it (the physics package imports both)
     _model_type = None
@@ -189,24 +197,32 @@ class Effect:
         return f"<effect {self.name}>"
 
     def transform_geometry(self, params, geometry: Geometry) -> Geometry:
+        """Hook: the geometry the other effects see (e.g. an angle offset); default unchanged."""
         return geometry
 
     def configure(self, ctx: Context) -> None:
+        """Hook: set what the other stages read from the context (slope distribution, Fresnel amplitudes) before any
+        lobe."""
         pass
 
     def specular_factor(self, ctx: Context):
+        """Hook: a factor on the specular lobe (shadowing-masking); None for none."""
         return None
 
     def modify_specular(self, ctx: Context, lobe):
+        """Hook: the specular lobe changed (e.g. depolarized); default unchanged."""
         return lobe
 
     def lobe(self, ctx: Context):
+        """Hook: an additive lobe (a Stokes vector or Mueller matrix array, or a DepolarizedLobe); None for none."""
         return None
 
     def modify_stokes(self, ctx: Context, total):
+        """Hook: the total Stokes vector or Mueller matrix changed (e.g. extinction); default unchanged."""
         return total
 
     def modify_dop(self, ctx: Context, dop):
+        """Hook: the measured DOP changed (e.g. an instrument bias); default unchanged."""
         return dop
 
 

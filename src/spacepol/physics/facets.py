@@ -36,6 +36,8 @@ def beckmann(tan2_alpha, sec4_alpha, sigma):
 
 
 def beckmann_anisotropic(tan2_alpha, sec4_alpha, phi_h, sigma_x, sigma_y, psi_deg):
+    """Beckmann slope distribution with RMS slopes ``sigma_x``, ``sigma_y`` along axes turned by ``psi_deg``, at
+    half-vector tilt (tan^2, sec^4) and azimuth ``phi_h``."""
     var_phi, _ = slope_widths(sigma_x, sigma_y, psi_deg, phi_h)
     return jnp.exp(-tan2_alpha / (2 * var_phi)) * sec4_alpha / (2 * np.pi * sigma_x * sigma_y)
 
@@ -47,6 +49,8 @@ def ggx(tan2_alpha, sec4_alpha, sigma):
 
 
 def ggx_anisotropic(tan2_alpha, sec4_alpha, phi_h, sigma_x, sigma_y, psi_deg):
+    """GGX (Trowbridge-Reitz) slope distribution with the same RMS slopes and axes as ``beckmann_anisotropic`` (alpha =
+    sqrt(2) sigma)."""
     var_phi, _ = slope_widths(sigma_x, sigma_y, psi_deg, phi_h)
     ax, ay = jnp.sqrt(2) * sigma_x, jnp.sqrt(2) * sigma_y
     return sec4_alpha / (np.pi * ax * ay * (1 + tan2_alpha / (2 * var_phi)) ** 2)

@@ -62,10 +62,12 @@ class Geometry:
 
     @property
     def shape(self):
+        """The shape of the angle arrays."""
         return self.theta_i.shape
 
     @property
     def size(self) -> int:
+        """The number of geometries."""
         return self.theta_i.shape[-1]
 
     def cached(self, key, compute):

@@ -39,10 +39,12 @@ class Prediction:
 
     @property
     def brdf(self):
+        """The BRDF (sr^-1) for unpolarized incidence: S0."""
         return self.stokes[0]
 
     @property
     def physical_dop(self):
+        """The DOP of the Stokes vector itself, before any measurement effect on the DOP (e.g. dop_bias)."""
         return degree_of_polarization(self.stokes)
 
     @property
@@ -86,6 +88,8 @@ class Model:
 
     @classmethod
     def from_string(cls, spec: str) -> "Model":
+        """The model of an effect list joined by ``+`` or a preset name (``paper``); unknown names and effects that do
+        not compose are one line."""
         return cls([registry.get(name) for name in registry.expand(spec)])
 
     def __add__(self, other):
@@ -97,6 +101,7 @@ class Model:
 
     @property
     def name(self) -> str:
+        """The model's effects joined by ``+``."""
         return "+".join(e.name for e in self.effects)
 
     def __repr__(self):
@@ -134,9 +139,11 @@ class Model:
 
     @property
     def free_parameters(self) -> list[Parameter]:
+        """The parameters that are not fixed."""
         return [p for p in self._parameters if not p.fixed]
 
     def parameter(self, name: str) -> Parameter:
+        """The parameter of this name; an unknown name is one line listing the model's parameters."""
         for p in self._parameters:
             if p.name == name:
                 return p
@@ -145,9 +152,11 @@ class Model:
         )
 
     def owner(self, name: str) -> str:
+        """The name of the effect that declares parameter ``name``."""
         return self._owner[name]
 
     def defaults(self) -> dict[str, float]:
+        """{parameter: default value} of every parameter."""
         return {p.name: p.default for p in self._parameters}
 
     def _resolve(self, params: dict, check: bool = True) -> tuple[dict, tuple]:
@@ -253,4 +262,5 @@ Effect._model_type = Model  # effect + effect -> Model (physics.effect)
 
 
 def build_model(spec: str | Model) -> Model:
+    """``spec`` as a Model: a Model as is, a string through ``Model.from_string``."""
     return spec if isinstance(spec, Model) else Model.from_string(spec)

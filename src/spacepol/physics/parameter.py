@@ -32,9 +32,11 @@ class Parameter:
 
     @property
     def effective_prior(self) -> Prior:
+        """The prior the parameter gets: a Fixed prior at its default when it is fixed, else its own."""
         return Fixed(self.default) if self.fixed else self.prior
 
     def describe(self) -> str:
+        """The parameter in one line: name, unit, prior, default and meaning."""
         unit = f" [{self.unit}]" if self.unit else ""
         state = f"fixed at {self.default:g}" if self.fixed else f"prior {self.prior}"
         return f"{self.name}{unit}: {self.description} ({state})"

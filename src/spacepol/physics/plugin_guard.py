@@ -20,6 +20,7 @@ class EffectError(SpacepolError):
 
 
 def is_plugin(effect) -> bool:
+    """True for an effect defined outside spacepol (a user's plug-in)."""
     return not type(effect).__module__.startswith("spacepol.")
 
 
@@ -57,6 +58,7 @@ def untraceable(effect, exc: BaseException) -> EffectError | None:
 
 
 def effect_failure(effect, exc: BaseException) -> EffectError:
+    """The EffectError that names a plug-in effect and what it did (raised, exited) instead of a traceback."""
     if isinstance(exc, SystemExit):
         what = f"called sys.exit({exc.code!r})"
     else:

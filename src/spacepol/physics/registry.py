@@ -14,12 +14,17 @@ from .effect import Effect
 
 
 class Registry:
+    """Effects by name: the built-in ones, plug-in files (``--effect FILE.py:Name``) and entry points (group
+    ``spacepol.effects``), with where each came from (``sources``)."""
+
     def __init__(self):
         self._effects: dict[str, type[Effect]] = {}
         self._entry_points_loaded = False
         self.sources: dict[str, str] = {}  # plug-in effect name -> where it came from ("path.py:Name", "entry point X")
 
     def register(self, cls: type[Effect]) -> type[Effect]:
+        """Add an effect class under its ``name`` (an Effect subclass with a name not taken by another class); returns
+        the class, so it serves as a decorator."""
         if not (inspect.isclass(cls) and issubclass(cls, Effect)):
             raise SpacepolError(f"{cls!r} is not an Effect subclass (use spacepol.physics.effect.Effect or @effect)")
         if not cls.name:
@@ -69,10 +74,12 @@ class Registry:
         return cls
 
     def names(self) -> list[str]:
+        """Every registered effect's name (entry points loaded first), in registration order."""
         self._load_entry_points()
         return list(self._effects)
 
     def get(self, name: str) -> type[Effect]:
+        """The effect class of this name; an unknown name is one line listing the known ones."""
         self._load_entry_points()
         try:
             return self._effects[name]

@@ -20,6 +20,7 @@ PAPER_CONSTANTS = {"sigma_p": 0.0136, "sigma_r": 0.0136, "u_p": 9.0, "v_p": 1.0}
 
 
 def paper_shadowing(geo, sigma_p, sigma_r, u_p, v_p):
+    """The paper's shadowing-masking function (eq 12 with its constants sigma_p, sigma_r, u_p, v_p) at the geometry."""
     ti, tr = jnp.radians(geo.theta_i), jnp.radians(geo.theta_r)
     cos_phi_r = jnp.cos(jnp.radians(geo.dphi))
     horizontal = 2.0 * geo.sin_alpha * geo.cos_beta  # |(k_i + k_r)_xy|

@@ -28,6 +28,7 @@ def wavelength_label(value: float) -> str:
 
 
 def cauchy_parameters() -> list[Parameter]:
+    """The parameters of the Cauchy law n(lambda) = A + B / lambda^2 that replace n's per-wavelength values."""
     return [Parameter("n_cauchy_a", "", Uniform(1.0, 3.0), 1.5, "Cauchy dispersion: n at infinite wavelength",
                       physical=(0.0, np.inf)),
             Parameter("n_cauchy_b", "um^2", Uniform(-0.05, 0.1), 0.005, "Cauchy dispersion: n = A + B / lambda^2")]
@@ -55,6 +56,7 @@ class SpectralModel:
 
     @property
     def name(self) -> str:
+        """The inner model's name (the wavelengths are in ``wavelengths``)."""
         return self.model.name
 
     def __repr__(self):
@@ -69,10 +71,12 @@ class SpectralModel:
 
     @property
     def effects(self):
+        """The inner model's effects."""
         return self.model.effects
 
     @property
     def parameters(self) -> list[Parameter]:
+        """The shared parameters, n and k per wavelength (``n@0.633``) or the dispersion law's parameters."""
         out = []
         for p in self.model.parameters:
             if p.name not in self.spectral:
@@ -85,6 +89,7 @@ class SpectralModel:
         return out
 
     def defaults(self) -> dict:
+        """{parameter: default value} of every parameter."""
         return {p.name: p.default for p in self.parameters}
 
     def values_at(self, params: dict, j: int) -> dict:
@@ -175,6 +180,7 @@ class SpectralModel:
 
     @property
     def inner(self) -> Model:
+        """The one-wavelength model the spectral model evaluates per wavelength."""
         return self.model
 
     def parts(self, geometry: Geometry) -> list:
@@ -183,6 +189,8 @@ class SpectralModel:
                 for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
 
     def evaluate(self, params: dict, geometry: Geometry, mueller: bool = False, check: bool = True) -> Prediction:
+        """The inner model's Prediction at each row's wavelength with that wavelength's n and k, rows in the data's
+        order."""
         parts = [(idx, self.model.evaluate(self.values_at(params, j), sub, mueller=mueller, check=check))
                  for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
         return _assemble(parts, geometry.size, mueller)
@@ -194,6 +202,7 @@ class SpectralModel:
         return _gather(parts, geometry.size, lambda dop: dop)
 
     def check_plugins(self, params: dict, geometry: Geometry) -> Prediction:
+        """``Model.check_plugins`` per wavelength: plug-in effects' failures named, the Prediction assembled."""
         parts = [(idx, self.model.check_plugins(self.values_at(params, j), sub))
                  for j, (idx, sub) in enumerate(self._groups(geometry)) if sub is not None]
         return _assemble(parts, geometry.size, False)

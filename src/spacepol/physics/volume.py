@@ -216,12 +216,16 @@ class SingleScattering(Effect):
     removable = True
 
     def phase_matrix(self, ctx, cos_theta):
+        """The phase matrix (4, 4, ...) at the internal scattering angle's cosine."""
         raise NotImplementedError
 
     def depolarization(self, ctx):
+        """(linear, circular) shares of polarization lost on the paths in and out; default none."""
         return (0.0, 0.0)
 
     def lobe(self, ctx):
+        """The once-scattered lobe under the interface: Fresnel transmission in, the phase matrix, transmission out,
+        over (mu_i' + mu_r')."""
         return single_scattering(ctx, ctx[self.intensity], lambda cos_theta: self.phase_matrix(ctx, cos_theta),
                                  self.depolarization(ctx))
 

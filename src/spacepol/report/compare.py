@@ -29,6 +29,8 @@ def _model_priors(posterior):
 
 def run_comparison(posterior, data, out: Path, methods=None, seeds: int = 3, base_seed: int = 0, rtol: float = 0.01,
                    progress: bool = True) -> dict:
+    """Every engine in ``methods`` from ``seeds`` starts on the same posterior: best objective against evaluations and
+    the spread of the optima; figures, JSON and report.html in ``out``; returns the JSON record."""
     methods = methods or DEFAULT_METHODS
     for m in methods:
         check_method(m)
@@ -111,6 +113,7 @@ def _markdown(report, names) -> str:
 
 
 def convergence_figure(runs, best_known, fig=None) -> Figure:
+    """Best objective against evaluations for each engine and seed; returns the Figure."""
     fig = fig or Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.add_subplot()
     methods = sorted({r["method"] for r in runs}, key=lambda m: [r["method"] for r in runs].index(m))

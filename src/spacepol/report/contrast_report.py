@@ -14,6 +14,8 @@ QUANTITIES = [("target_dop", "target DOP", "{:.3f}"), ("sky_dop", "sky DOP", "{:
 
 
 def table3_lines(report: dict) -> list[str]:
+    """Table 3 as a Markdown table: each case's quantities as median [5 %, 95 %] and the input that dominates the
+    spread."""
     head = "| case | " + " | ".join(label for _, label, _ in QUANTITIES) + " | spread dominated by |"
     lines = [head, "|" + "---|" * (len(QUANTITIES) + 2)]
     for row in report["rows"]:
@@ -24,6 +26,7 @@ def table3_lines(report: dict) -> list[str]:
 
 
 def dominance_paragraph(report: dict) -> str:
+    """Per case, which input (material, geometry, sky) dominates the polarization contrast's spread, in words."""
     parts = []
     for row in report["rows"]:
         w = row["dominant_input"]["widths_90"]
@@ -48,6 +51,7 @@ def make_contrast_report(result, scenario, out: Path, reading: str = "corrected"
 
 
 def assumptions(summary: dict, scenario, material: dict | None = None) -> list[str]:
+    """What the contrast assumed (geometry, material rule, sky model, radiometry), one sentence each."""
     t, sky_ = scenario.target, scenario.sky
     return [
         f"Target DOP from the posterior of {summary['model']} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "

@@ -56,6 +56,8 @@ def _fine_grid(theta_i_values):
 
 
 def forward_comparison(data, out: Path) -> list[str]:
+    """The demo's first section: the paper's model and paper+polarized_diffuse at a PTFE-like guess against PTFE's
+    measured DOP and BRDF; writes the CSV and figure, returns the lines it reports."""
     models = {name: Model.from_string(name) for name in ("paper", "paper+polarized_diffuse")}
     params = {"paper": PTFE_GUESS, "paper+polarized_diffuse": {**PTFE_GUESS, "rho_d": 0.5, "rho_pd": 0.5}}
     columns = {"theta_i": data.theta_i, "theta_r": data.theta_r, "dphi": data.dphi,
@@ -153,6 +155,8 @@ def _effect_parameters(name: str) -> list[str]:
 
 
 def run_demo(out: Path, seed: int = 0) -> None:
+    """The demo: forward model on PTFE, inversion, a hidden effect named on a synthetic set, diagnose and ladder on
+    PTFE, Table 3 as distributions; report.html in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
     measured = read_measurements(source).at_wavelength(0.633)

@@ -15,6 +15,7 @@ from .inversion_figures import residual_figure
 
 
 def pareto_warnings(summary: dict) -> list[str]:
+    """Sentences for the fits whose PSIS-LOO has observations with Pareto k above 0.7."""
     bad = summary.get("pareto_k_bad", [])
     if not bad:
         return []
@@ -24,6 +25,7 @@ def pareto_warnings(summary: dict) -> list[str]:
 
 
 def ranking_rows(report: dict) -> list[list]:
+    """The ranking as table rows (change, delta ELPD and its SE, significance, how the refit's posterior was obtained)."""
     rows = []
     for r in report["ranking"]:
         confirmed = r["delta_elpd"] is not None
@@ -41,6 +43,7 @@ def _name(entry: dict) -> str:
 
 
 def figure_name(change_label: str) -> str:
+    """A file name for a change's residual figure."""
     words = change_label.split()
     return f"residuals_{words[1]}.png" if words[0] == "add" else "residuals_" + "_".join(words) + ".png"
 

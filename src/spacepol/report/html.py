@@ -8,30 +8,36 @@ import io
 
 
 def figure_to_data_uri(fig) -> str:
+    """A Matplotlib figure as an embeddable PNG data URI."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
 
 
 def png_file_to_data_uri(path) -> str:
+    """A PNG file as an embeddable data URI."""
     return "data:image/png;base64," + base64.b64encode(open(path, "rb").read()).decode()
 
 
 def table(header, rows) -> str:
+    """An HTML table of ``header`` and ``rows`` (cells escaped)."""
     head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows)
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
 def paragraph(text) -> str:
+    """An HTML paragraph of escaped text."""
     return f"<p>{html.escape(text)}</p>"
 
 
 def bullets(items) -> str:
+    """An HTML list of escaped items (empty for none)."""
     return "<ul>" + "".join(f"<li>{html.escape(i)}</li>" for i in items) + "</ul>"
 
 
 def image(uri, caption="") -> str:
+    """An HTML image of a data URI."""
     cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
     return f'<figure><img src="{uri}" style="max-width:100%">{cap}</figure>'
 

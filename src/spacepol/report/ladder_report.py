@@ -19,6 +19,7 @@ def _posterior_check(rung: dict) -> str:
 
 
 def ladder_table(public: list[dict]) -> list[str]:
+    """The ladder as a Markdown table: model, fit figures, ELPD-LOO and its change, how each posterior was obtained."""
     noise = list(dict.fromkeys(k for r in public for k in r.get("inferred_noise", {})))
     head = "| rung | model | RMSE(DOP) | chi2_red | ELPD-LOO |" + "".join(f" {n} (inferred) |" for n in noise) + " posterior check |"
     lines = [head, "|" + "---|" * (6 + len(noise))]

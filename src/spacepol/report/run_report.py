@@ -17,6 +17,7 @@ from .inversion_figures import corner_figure, fit_figure, mueller_residual_figur
 
 
 def truths_from_metadata(metadata: dict) -> dict:
+    """{parameter: true value} from a synthetic file's ``truth_NAME`` metadata (empty for real data)."""
     out = {}
     for key, value in metadata.items():
         if key.startswith("truth_"):
@@ -50,6 +51,8 @@ def compare_with_references(result, references: dict) -> dict:
 
 
 def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = None, references: dict | None = None) -> dict:
+    """A run's files in ``out``: corner, fit and residual figures, posterior.nc and summary.json (``Result.save``),
+    report.html; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
     posterior, result, summary = inv.posterior, inv.draws, inv.summary
     if references:

@@ -11,6 +11,7 @@ import numpy as np
 
 
 def unit_vector(zenith_deg, azimuth_deg) -> np.ndarray:
+    """Unit vectors (x east, y north, z up) of directions at zenith and azimuth (deg, east of north)."""
     t, p = np.radians(zenith_deg), np.radians(azimuth_deg)
     return np.stack(np.broadcast_arrays(np.sin(t) * np.sin(p), np.sin(t) * np.cos(p), np.cos(t)), axis=-1)
 

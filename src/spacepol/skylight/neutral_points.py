@@ -44,6 +44,7 @@ def _homogeneous(v):
 
 
 def stereographic_zeta(zenith_deg, azimuth_deg):
+    """The stereographic coordinate of a sky direction as a complex number (Berry, Dennis and Lee's zeta)."""
     return np.tan(np.radians(zenith_deg) / 2) * np.exp(1j * np.radians(90.0 - np.asarray(azimuth_deg, float)))
 
 
@@ -68,6 +69,8 @@ class BerryDennisLeeSky:
         return {k: tuple(float(x) for x in angles(v)) for k, v in pts.items()}
 
     def w(self, zenith_deg, azimuth_deg, sun) -> np.ndarray:
+        """Berry, Dennis and Lee's complex polarization field w at the directions: |w| sets the DOP, arg(w)/2 the angle
+        of polarization."""
         zeta = stereographic_zeta(zenith_deg, azimuth_deg)
         s = unit_vector(*sun)
         points = [unit_vector(*p) for p in self.neutral_points(sun).values()]
@@ -81,6 +84,7 @@ class BerryDennisLeeSky:
         return w * np.conj(ref) ** 2 / np.abs(ref) ** 2
 
     def dop(self, zenith_deg, azimuth_deg, sun) -> np.ndarray:
+        """The sky's DOP: P_max |w| / (2 - |w|), zero at the four neutral points."""
         m = np.minimum(np.abs(self.w(zenith_deg, azimuth_deg, sun)), 1.0)
         return self.p_max * m / (2.0 - m)
 

@@ -30,9 +30,11 @@ class Projection:
     label: str
 
     def radius(self, theta):
+        """Radius on the map of a zenith angle (radians)."""
         raise NotImplementedError
 
     def zenith_angle(self, r):
+        """Zenith angle (radians) of a radius on the map."""
         raise NotImplementedError
 
     def radial_scale(self, theta):
@@ -40,6 +42,7 @@ class Projection:
         raise NotImplementedError
 
     def forward(self, zenith_deg, azimuth_deg) -> tuple[np.ndarray, np.ndarray]:
+        """Map coordinates (x east, y north) of directions at zenith and azimuth (deg)."""
         r = self.radius(np.radians(zenith_deg))
         phi = np.radians(azimuth_deg)
         return r * np.sin(phi), r * np.cos(phi)
@@ -50,6 +53,7 @@ class Projection:
         return np.degrees(self.zenith_angle(r)), np.degrees(np.arctan2(x, y)) % 360.0
 
     def horizon_radius(self) -> float:
+        """The map radius of the horizon."""
         return float(self.radius(np.pi / 2))
 
     def tissot(self, zenith_deg) -> dict[str, np.ndarray]:
@@ -63,6 +67,8 @@ class Projection:
 
 
 class Stereographic(Projection):
+    """Stereographic projection r = 2 tan(theta / 2): conformal (the paper's "complex spherical" plane)."""
+
     def radius(self, theta):
         return 2 * np.tan(np.asarray(theta) / 2)
 
@@ -74,6 +80,8 @@ class Stereographic(Projection):
 
 
 class Orthographic(Projection):
+    """Orthographic projection r = sin(theta): the sky as seen from far above."""
+
     def radius(self, theta):
         return np.sin(theta)
 
@@ -85,6 +93,8 @@ class Orthographic(Projection):
 
 
 class LambertEqualArea(Projection):
+    """Lambert azimuthal equal-area projection r = 2 sin(theta / 2): areas kept."""
+
     def radius(self, theta):
         return 2 * np.sin(np.asarray(theta) / 2)
 
@@ -103,6 +113,7 @@ PROJECTIONS = {
 
 
 def projection(name: str) -> Projection:
+    """The projection of this name (stereographic, orthographic, lambert); an unknown name is one line."""
     try:
         return PROJECTIONS[name]
     except KeyError:

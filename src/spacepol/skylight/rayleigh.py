@@ -31,6 +31,7 @@ class RayleighSky:
             raise ParameterError(f"P_max = {self.p_max}: a degree of polarization lies in [0, 1]")
 
     def scattering_cosine(self, zenith_deg, azimuth_deg, sun) -> np.ndarray:
+        """Cosine of the scattering angle between the sun and each direction."""
         v = unit_vector(zenith_deg, azimuth_deg)
         s = unit_vector(sun[0], sun[1])
         return np.clip(np.sum(v * s, axis=-1), -1.0, 1.0)
@@ -41,6 +42,8 @@ class RayleighSky:
         return self.p_max * (1.0 - c2) / (1.0 + c2)
 
     def e_vector(self, zenith_deg, azimuth_deg, sun) -> np.ndarray:
+        """The E-vector of single Rayleigh scattering (perpendicular to the scattering plane) as unit vectors; NaN at
+        the sun and anti-sun."""
         v = unit_vector(zenith_deg, azimuth_deg)
         s = unit_vector(sun[0], sun[1])
         e = np.cross(np.broadcast_to(s, v.shape), v)
@@ -48,6 +51,7 @@ class RayleighSky:
         return np.where(norm > 1e-12, e / np.where(norm > 0, norm, 1.0), np.nan)  # undefined at sun / anti-sun
 
     def aop(self, zenith_deg, azimuth_deg, sun) -> np.ndarray:
+        """Angle of polarization (deg) from the local meridian (``directions.angle_of_polarization``)."""
         return angle_of_polarization(self.e_vector(zenith_deg, azimuth_deg, sun), zenith_deg, azimuth_deg)
 
 

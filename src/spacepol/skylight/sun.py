@@ -36,6 +36,7 @@ class SunPosition:
 
     @property
     def altitude_deg(self) -> float:
+        """The sun's altitude above the horizon (90 - zenith), degrees."""
         return 90.0 - self.zenith_deg
 
 

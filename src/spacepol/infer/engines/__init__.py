@@ -23,6 +23,7 @@ def check_method(method: str) -> str:
 
 
 def optimize(method: str, objective, rng, model_name: str = "", **options):
+    """Run the optimizer ``method`` (``ga``, ``de``, ``nlopt:ALGO``) on ``objective``; its EngineResult."""
     if method == "ga":
         return run_ga(objective, rng, model_name=model_name, **options)
     if method == "de":

@@ -30,6 +30,9 @@ def _decode(chromosomes, bits):
 def run_ga(objective, rng: np.random.Generator, model_name: str = "", bits: int = 16, population: int = 100,
            p_crossover: float = 0.02, p_mutation: float = 0.02, max_generations: int = 100,
            tolerance: float = 1e-3, n_replace: int = 20, seed: int | None = None) -> EngineResult:
+    """The paper's genetic algorithm (binary genes of ``bits`` per parameter over the prior cube, crossover, mutation,
+    the worst ``n_replace`` replaced per generation), stopped when the best changes by less than ``tolerance``
+    or after ``max_generations``; its EngineResult with the search history."""
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim
     history = History()

@@ -23,6 +23,8 @@ def check_algorithm(algorithm: str) -> int:
 
 def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: str = "",
               max_evaluations: int = 20000, ftol_rel: float = 1e-10, seed: int | None = None) -> EngineResult:
+    """An nlopt algorithm on the prior cube from a random start, at most ``max_evaluations``; its EngineResult with the
+    search history."""
     code = check_algorithm(algorithm)
     start = time.perf_counter()
     priors, ndim = objective.priors, objective.priors.ndim

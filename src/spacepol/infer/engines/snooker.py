@@ -18,6 +18,8 @@ class DESnookerMove(emcee.moves.DESnookerMove):
     """emcee's snooker move with the unit vector and the (d - 1) Jacobian exponent of ter Braak & Vrugt (2008)."""
 
     def get_proposal(self, s, c, random):
+        """emcee's move interface: proposals for the walkers ``s`` from the complementary ensemble ``c``, with their
+        log Metropolis factors."""
         count, ndim = s.shape
         sizes = list(map(len, c))
         q = np.empty_like(s)

@@ -29,7 +29,7 @@ from spacepol import configure_process
 
 configure_process(small_calls=True)  # as the command line runs
 
-from spacepol.infer.engines import optimize  # noqa: E402
+from spacepol.infer.engine_registry import optimize  # noqa: E402
 from spacepol.infer.engines.nuts import sample_nuts  # noqa: E402
 from spacepol.infer.inversion import invert  # noqa: E402
 from spacepol.infer.objective import PaperObjective  # noqa: E402

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from spacepol.infer.engines import optimize
+from spacepol.infer.engine_registry import optimize
 from spacepol.infer.inversion import invert
 from spacepol.infer.objective import PaperObjective
 from spacepol.infer.posterior import Posterior

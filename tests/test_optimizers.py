@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from spacepol.infer.engines import OPTIMIZERS, optimize
+from spacepol.infer.engine_registry import OPTIMIZERS, optimize
 from spacepol.infer.engines.ga import _decode
 from spacepol.infer.objective import PaperObjective
 from spacepol.infer.prior_set import PriorSet

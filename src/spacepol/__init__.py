@@ -26,7 +26,7 @@ from ._runtime import configure_process
 _API = {
     "load": "api", "parse_wavelengths": "api", "build_model": "api", "build_posterior": "api",
     "parse_observables": "api", "invert": "api", "forward": "api", "synth": "api", "contrast": "api",
-    "parameter_values": "api", "Contrast": "api", "ENGINES": "api", "sky": "api", "Sky": "api",
+    "parameter_values": "api", "Contrast": "api", "sky": "api", "Sky": "api",
     "diagnose": "api", "Diagnosis": "api", "ladder": "api", "Ladder": "api", "design": "api", "Design": "api",
     "Result": "infer.result", "Diagnostics": "infer.result", "Fit": "infer.result",
     "Dataset": "io.dataset", "Model": "physics.model", "Geometry": "physics.geometry",

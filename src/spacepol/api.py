@@ -24,7 +24,6 @@ from .infer.result import Result
 from .io.dataset import Dataset
 from .physics.model import Model
 
-ENGINES = ("emcee", "laplace")
 
 
 def parse_wavelengths(text: str):
@@ -138,61 +137,54 @@ def _prior_overrides(prior) -> dict | None:
 
 
 def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0, out=None, *,
-           observables=None, dispersion=None, walkers: int | None = None, steps: int = 20000, robust: bool = False,
-           restart: bool = False, progress: bool = False, references: dict | None = None) -> Result:
+           observables=None, dispersion=None, walkers: int | None = None, steps: int | None = None,
+           robust: bool = False, restart: bool = False, progress: bool = False, references: dict | None = None,
+           engine_options: dict | None = None) -> Result:
     """Sample the posterior of ``model`` (an effect list, a preset or a Model) on ``data`` (a Dataset or a file path) and return its Result.
 
-    ``engine``: ``emcee`` (affine-invariant ensemble, the default) or ``laplace`` (a Laplace approximation at the
-    optimum corrected by importance sampling; an error where its weights cannot be trusted). With ``out`` the run is
-    kept in that folder as ``invert-mcmc run`` keeps it: the chain (an interrupted call continues with the same
-    arguments; ``restart`` starts afresh and keeps the old chain aside), posterior.nc, summary.json, figures and
-    report.html. ``references``: {parameter: value} to compare the posterior with (e.g. a known index)."""
-    if engine not in ENGINES:
-        raise UnknownNameError(f"unknown engine '{engine}' (known: {', '.join(ENGINES)})")
+    ``engine``: a sampler of the engine registry: ``emcee`` (affine-invariant ensemble, the default), ``laplace`` (a
+    Laplace approximation at the optimum corrected by importance sampling; an error where its weights cannot be
+    trusted), ``nuts``, an entry point of group ``spacepol.engines`` or a file ``path/to/engine.py:Name``.
+    ``walkers`` and ``steps`` are emcee's (``walkers``, ``max_steps``); ``engine_options`` go to the engine's ``run``.
+    With ``out`` the run is kept in that folder as ``invert-mcmc run`` keeps it: for a resumable engine (emcee) the
+    chain (an interrupted call continues with the same arguments; ``restart`` starts afresh and keeps the old chain
+    aside), posterior.nc, summary.json, figures and report.html. ``references``: {parameter: value} to compare the
+    posterior with (e.g. a known index)."""
+    from .infer.engine_registry import SAMPLER, engines
+
+    sampler = engines.get(engine, SAMPLER)
+    options = {**({"walkers": walkers} if walkers is not None else {}),
+               **({"max_steps": steps} if steps is not None else {}), **(engine_options or {})}
+    sampler.check_options(options)
     data = load(data) if isinstance(data, (str, Path)) else data
     post = build_posterior(data, model, prior, observables, dispersion, robust)
-    from .infer.inversion import check_walkers
+    if walkers is not None:
+        from .infer.inversion import check_walkers
 
-    check_walkers(walkers, post.ndim)
+        check_walkers(walkers, post.ndim)
     if references:
         for name, value in references.items():
             if name not in post.names:
                 raise ParameterError(f"--reference '{name}={value:g}': '{name}' is not a free parameter "
                                      f"({', '.join(post.names)})")
     if out is None:
-        return _sample(post, engine, seed, walkers, steps, None, progress)
-    return _invert_into(Path(out), post, engine, seed, walkers, steps, restart, progress, references)
+        return sampler.result(post, seed=seed, progress=progress, **options)
+    return _invert_into(Path(out), post, sampler, seed, options, restart, progress, references)
 
 
-def _sample(post, engine: str, seed: int, walkers, steps: int, chain, progress: bool) -> Result:
-    from .infer.inversion import invert as invert_emcee, invert_laplace
-
-    if engine == "emcee":
-        return invert_emcee(post, seed=seed, walkers=walkers, max_steps=steps, backend_path=chain, progress=progress)
-    from .infer.optimum import find_optimum
-
-    _, centre = find_optimum(post, np.random.default_rng(seed))
-    result = invert_laplace(post, centre, seed=seed)
-    if result is None:
-        raise SpacepolError(f"engine laplace: the Laplace approximation of {post.likelihood.model.name} cannot be trusted "
-                            f"here (its importance weights failed their checks); use engine emcee")
-    return result
-
-
-def _invert_into(out: Path, post, engine, seed, walkers, steps, restart, progress, references) -> Result:
+def _invert_into(out: Path, post, sampler, seed, options, restart, progress, references) -> Result:
     from .infer.chain_file import set_aside
-    from .infer.inversion import check_resumable
     from .io.output import check_output_dir, folder_lock
     from .report.run_report import write_run_report
 
     check_output_dir(out)
     made_folder = not out.exists()
-    chain = out / "chain.h5" if engine == "emcee" else None
+    chain = out / "chain.h5" if sampler.resumable else None
     fresh = chain is None or not chain.exists()
     with folder_lock(out):  # first: a second run on this folder stops here, before it reads the chain
         try:
             if chain is not None and not restart:
-                check_resumable(chain, post, walkers, seed)
+                sampler.check_chain(chain, post, seed, **options)
             if progress:
                 lik = post.likelihood
                 print(f"sampling {', '.join(post.names)} from {len(lik.data)} geometries ({', '.join(lik.observables)}), "
@@ -202,7 +194,7 @@ def _invert_into(out: Path, post, engine, seed, walkers, steps, restart, progres
                           f"holds their numbers; --observables chooses)", file=sys.stderr)
             if restart and chain is not None and (old := set_aside(chain)) is not None and progress:
                 print(f"  --restart: the previous chain is kept as {old}", file=sys.stderr)
-            result = _sample(post, engine, seed, walkers, steps, chain, progress)
+            result = sampler.result(post, seed=seed, progress=progress, chain=chain, **options)
         except KeyboardInterrupt:
             raise  # the chain so far is kept: the same call continues it
         except BaseException:

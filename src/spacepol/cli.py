@@ -95,10 +95,13 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
         p.add_argument("--seed", type=SEED, default=0)
 
-    p = sub.add_parser("run", help="emcee posterior with corner, fit and residual plots and a report")
+    p = sub.add_parser("run", help="posterior (emcee by default) with corner, fit and residual plots and a report")
     data_options(p)
     p.add_argument("--walkers", type=_int_at_least(2), default=None, help="even, >= 2 x parameters (default 32 or more)")
-    p.add_argument("--steps", type=_int_at_least(100), default=20000, help="cap on the chain length (steps)")
+    p.add_argument("--steps", type=_int_at_least(100), default=None, help="emcee: cap on the chain length (default 20000)")
+    p.add_argument("--engine", default="emcee", metavar="NAME",
+                   help="the sampler: emcee (default), laplace, nuts, an entry point of group spacepol.engines, or "
+                        "path/to/engine.py:Name")
     p.add_argument("--restart", action="store_true",
                    help="start the chain afresh; an existing chain.h5 is kept aside as chain.h5.old")
     p.add_argument("--robust", action="store_true", help="Student-t likelihood (nu = 4) instead of Gaussian")

@@ -143,7 +143,10 @@ def run(args) -> int:
     from .api import invert
 
     check_output_dir(args.out)  # before the data are read
-    summary = invert(load_dataset(args), args.model, args.prior, "emcee", args.seed, args.out,
+    from .infer.engine_registry import SAMPLER, engines
+
+    engines.get(args.engine, SAMPLER)  # a wrong name fails before the data are read
+    summary = invert(load_dataset(args), args.model, args.prior, args.engine, args.seed, args.out,
                      observables=args.observables, dispersion=args.dispersion, walkers=args.walkers, steps=args.steps,
                      robust=args.robust, restart=args.restart, progress=not args.quiet,
                      references=parse_references(args.reference)).summary
@@ -156,32 +159,33 @@ def run(args) -> int:
     for line in noise_findings(summary.get("noise", {})):
         print(f"noise: {line}")
     d = summary["diagnostics"]
+    quality = (f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}" if d.get("rhat_max") is not None
+               else f"Pareto k {d.get('pareto_k', float('nan')):.2f}, {d['ess_min']:.0f} effective draws")
+    evidence = summary.get("log_evidence")
+    if evidence:
+        quality += f", ln Z {evidence['value']:.2f} +- {evidence['error']:.2f}"
     print(f"wrote {args.out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, residual_trends.png, "
-          f"report.html (R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}, {summary['seconds']:.1f} s)")
+          f"report.html ({quality}, {summary['seconds']:.1f} s)")
     return 0
 
 
 def optimize(args) -> int:
-    """``invert-mcmc optimize``: one optimizer (``ga``, ``de``, ``nlopt:ALGO``) or emcee on the paper's objective;
-    prints its Result as JSON."""
+    """``invert-mcmc optimize``: one optimizer (``ga``, ``de``, ``nlopt:ALGO``) on the paper's objective, or a sampler
+    (``emcee``, ...) on the posterior; prints its EngineResult as JSON."""
     import json
 
-    from .infer.engines import optimize as run_optimizer
+    from .infer.engine_registry import SAMPLER, check_method, engines, optimize as run_optimizer
     from .infer.objective import PaperObjective
     from .infer.prior_set import PriorSet
     from .io.atomic import _jsonable
 
-    from .infer.engines import check_method
-
     check_method(args.method)
     data = load_dataset(args)
-    if args.method == "emcee":
-        from .infer.inversion import invert
-
-        inv = invert(build_posterior(args, data), seed=args.seed, progress=False)
-        result = inv.draws
+    posterior = build_posterior(args, data)
+    engine = engines.get(args.method)
+    if engine.kind == SAMPLER:
+        result = engine.result(posterior, seed=args.seed).draws
     else:
-        posterior = build_posterior(args, data)
         model = posterior.likelihood.model
         model_priors = PriorSet(model.parameters, {n: posterior.priors.priors[n] for n in posterior.priors.priors
                                                    if n in {p.name for p in model.parameters}})
@@ -195,7 +199,7 @@ def compare(args) -> int:
     """``invert-mcmc compare``: several engines and seeds on the same posterior; figures and table in ``--out``."""
     from .report.compare import run_comparison
 
-    from .infer.engines import check_method
+    from .infer.engine_registry import check_method
 
     check_output_dir(args.out)
     for method in args.methods or []:

@@ -93,7 +93,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
         compact(backend_path)
     idata = to_inference_data(result, posterior, rng, max_pointwise_draws)
     loo_result = loo(idata)
-    return _inversion(posterior, result, idata, loo_result, convergence(idata, result), seed, start)
+    return _inversion(posterior, result, idata, loo_result, {**convergence(idata, result), "engine": "emcee"}, seed, start)
 
 
 def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) -> Result | None:
@@ -128,6 +128,14 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     return _inversion(posterior, result, idata, loo_result, diagnostics, seed, start)
 
 
+def result_of(posterior: Posterior, draws: EngineResult, rng: np.random.Generator, seed: int, start: float,
+              engine: str | None = None) -> Result:
+    """The Result of a sampler's draws (any engine): ArviZ groups, R-hat and ESS, PSIS-LOO and the summary."""
+    idata = to_inference_data(draws, posterior, rng)
+    diagnostics = {**convergence(idata, draws), "engine": engine or draws.method}
+    return _inversion(posterior, draws, idata, loo(idata), diagnostics, seed, start)
+
+
 def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: dict, diagnostics: dict, seed: int,
                start: float) -> Result:
     """The Result of a posterior's draws: summary (quantiles, fit, noise ratios, identifiability, residual
@@ -150,6 +158,9 @@ def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: di
         "sampler": {k: v for k, v in result.info.items() if k not in ("tau", "start_search")} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
+    if "log_evidence" in result.info:  # an engine that estimates the evidence (a nested sampler)
+        summary["log_evidence"] = {"value": float(result.info["log_evidence"]),
+                                   "error": float(result.info.get("log_evidence_error", np.nan))}
     if "start_search" in result.info:  # the modes the start-point searches found (infer.modes)
         summary["start_search"] = result.info["start_search"]
     noise = noise_ratios(posterior, summary["parameters"])

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import importlib.util
 import inspect
-import traceback
 from importlib.metadata import entry_points
-from pathlib import Path
 
 from ..errors import SpacepolError, UnknownNameError
+from ..plugins import load_attribute
 from .builtin_effects import BUILTIN_EFFECTS, PRESETS
 from .effect import Effect
 
@@ -48,29 +46,9 @@ class Registry:
 
     def load_file(self, spec: str) -> type[Effect]:
         """Load ``path/to/file.py:ClassName`` and register it."""
-        path_text, sep, attr = spec.rpartition(":")
-        if not sep or not attr:
-            raise SpacepolError(f"--effect '{spec}': expected path/to/file.py:Name")
-        path = Path(path_text)
-        if not path.is_file():
-            raise SpacepolError(f"--effect '{spec}': file {path} not found")
-        module_name = f"spacepol_user_effect_{path.stem}"
-        module_spec = importlib.util.spec_from_file_location(module_name, path)
-        module = importlib.util.module_from_spec(module_spec)
-        try:
-            module_spec.loader.exec_module(module)
-        except SystemExit as exc:
-            raise SpacepolError(f"--effect '{spec}': importing {path} called sys.exit({exc.code!r})") from None
-        except Exception as exc:
-            here = path.resolve()
-            line = next((n for f, n in traceback.walk_tb(exc.__traceback__)
-                         if Path(f.f_code.co_filename).resolve() == here), None)
-            at = f" (line {line})" if line else ""
-            raise SpacepolError(f"--effect '{spec}': importing {path} failed{at}: {type(exc).__name__}: {exc}") from None
-        if not hasattr(module, attr):
-            raise SpacepolError(f"--effect '{spec}': {path} defines no '{attr}'")
-        cls = self.register(getattr(module, attr))
-        self.sources[cls.name] = f"{path.resolve()}:{attr}"
+        obj, source = load_attribute(spec, "--effect", "spacepol_user_effect")
+        cls = self.register(obj)
+        self.sources[cls.name] = source
         return cls
 
     def names(self) -> list[str]:

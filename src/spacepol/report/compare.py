@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..infer.engines import OPTIMIZERS, check_method, optimize
-from ..infer.inversion import invert
+from ..infer.engine_registry import OPTIMIZERS, SAMPLER, check_method, engines, optimize
 from ..infer.objective import PaperObjective
 from ..infer.prior_set import PriorSet
 from ..io.atomic import atomic_path, save_figure, write_json
@@ -43,12 +42,13 @@ def run_comparison(posterior, data, out: Path, methods=None, seeds: int = 3, bas
     runs = []
     inv = None
     for method in methods:
-        for k in range(seeds if method != "emcee" else 1):
+        engine = engines.get(method)
+        for k in range(seeds if engine.kind != SAMPLER else 1):
             seed = base_seed + k
             if progress:
                 print(f"  {method} seed {seed} ...", flush=True)
-            if method == "emcee":
-                inv = invert(posterior, seed=seed, progress=False)
+            if engine.kind == SAMPLER:
+                inv = engine.result(posterior, seed=seed)
                 res = inv.draws
                 point = np.array([[res.best.get(n, posterior.priors.fixed.get(n)) for n in objective.names]])
                 value = float(objective(point)[0])

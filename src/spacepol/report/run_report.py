@@ -84,15 +84,24 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
     for name, q in s["parameters"].items():
         truth = truths.get(name)
         flagged = any(f["parameter"] == name for f in s["identifiability"].get("at_bound", []))
+        chain = diag.get("per_parameter", {}).get(name)  # None for importance-weighted draws (no chains)
         rows.append([name + (" (at a bound)" if flagged else ""), f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
-                     f"{diag['per_parameter'][name]['rhat']:.4f}", f"{diag['per_parameter'][name]['ess_bulk']:.0f}",
+                     f"{chain['rhat']:.4f}" if chain else "n/a", f"{chain['ess_bulk']:.0f}" if chain else "n/a",
                      "" if truth is None else f"{truth:.4g}", s["priors"].get(name, "")])
     for name, q in s.get("derived", {}).items():  # implied by a dispersion law, not sampled themselves
         rows.append([f"{name} (from the dispersion law)", f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]",
                      f"[{q['q16']:.4g}, {q['q84']:.4g}]", "", "", "" if truths.get(name) is None else f"{truths[name]:.4g}", ""])
-    converged = diag["rhat_max"] <= 1.01 and diag["ess_min"] >= 400 and not s["sampler"].get("capped")
-    verdict = ("Converged: R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
-               "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting the intervals.")
+    quality = inv.diagnostics
+    converged = quality.converged and not quality.capped
+    if quality.engine == "laplace-is":
+        verdict = (f"Laplace approximation corrected by importance sampling: Pareto k {quality.pareto_k:.2f}, "
+                   f"{quality.ess_min:.0f} effective draws (trusted: k <= 0.7, >= 400 draws, weights not collapsed).")
+    else:
+        verdict = (f"Converged ({quality.engine}): R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
+                   "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting "
+                   "the intervals.")
+    if s.get("log_evidence"):
+        verdict += f" Log evidence ln Z = {s['log_evidence']['value']:.2f} +- {s['log_evidence']['error']:.2f}."
     if s["sampler"].get("capped"):
         verdict += f" The chain hit the step cap ({s['sampler']['steps']} steps) before reaching 50 autocorrelation times."
     sections = [
@@ -103,8 +112,8 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
          + (H.bullets([bound_finding(f) for f in s["identifiability"].get("at_bound", [])]))),
         ("Convergence", H.paragraph(verdict) + H.table(
             ["R-hat max", "ESS min (bulk/tail)", "tau max (steps)", "acceptance", "walkers", "steps", "burn-in", "thin"],
-            [[f"{diag['rhat_max']:.4f}", f"{diag['ess_min']:.0f}", f"{diag['tau_max']:.1f}", f"{diag['acceptance']:.2f}",
-              s["sampler"]["walkers"], s["sampler"]["steps"], s["sampler"]["burn_in"], s["sampler"]["thin"]]])),
+            [[_fmt(quality.rhat_max, "{:.4f}"), _fmt(quality.ess_min, "{:.0f}"), _fmt(quality.tau_max, "{:.1f}"),
+              _fmt(diag.get("acceptance"), "{:.2f}"), *(s["sampler"].get(k, "n/a") for k in ("walkers", "steps", "burn_in", "thin"))]])),
         ("What the data determine", H.bullets(s["identifiability"]["findings"])
          + (H.paragraph("Where the chain started:") + H.bullets(s["start_search"]["findings"])
             if s.get("start_search", {}).get("findings") else "")),
@@ -130,5 +139,5 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
     return H.page(f"spacepol inversion: {s['model']}", sections)
 
 
-def _fmt(x):
-    return "n/a" if x is None else f"{x:.4g}"
+def _fmt(x, pattern: str = "{:.4g}"):
+    return "n/a" if x is None or (isinstance(x, float) and not np.isfinite(x)) else pattern.format(x)

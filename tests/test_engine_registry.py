@@ -82,7 +82,7 @@ def test_names_variants_and_kinds_resolve():
 @pytest.mark.parametrize("name, words", [
     ("hmc", "unknown engine 'hmc'"),
     ("nlopt", "needs a variant"),
-    ("nlopt:LBFGS", "unknown variant 'LBFGS'"),
+    ("nlopt:LBFGS", "unknown nlopt global algorithm 'LBFGS'"),
     ("ga", "is an optimizer, not a sampler"),
     ("missing.py:X", "file missing.py not found"),
 ])

@@ -75,8 +75,8 @@ class EngineRegistry:
             cls = self._engines.get(base)
             if cls is None:
                 raise UnknownNameError(f"unknown engine '{name}' (known: {self._listing(kind)}; or path/to/file.py:Name)")
-            if variant and variant not in cls.variants:
-                raise UnknownNameError(f"engine {base}: unknown variant '{variant}' (known: {', '.join(cls.variants) or 'none'})")
+            if variant:
+                cls.check_variant(variant)
             if cls.variants and not variant:
                 raise UnknownNameError(f"engine {base} needs a variant, {base}:NAME (NAME in {', '.join(cls.variants)})")
             engine = cls(variant or None)

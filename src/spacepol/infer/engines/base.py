@@ -28,6 +28,14 @@ class Engine:
     def __init__(self, variant: str | None = None):
         self.variant = variant
 
+    @classmethod
+    def check_variant(cls, variant: str) -> None:
+        """A variant (the text after ``name:``) this engine takes; else one line naming the ones it knows."""
+        if variant not in cls.variants:
+            from ...errors import UnknownNameError
+
+            raise UnknownNameError(f"engine {cls.name}: unknown variant '{variant}' (known: {', '.join(cls.variants) or 'none'})")
+
     def run(self, problem, rng: np.random.Generator, **options) -> EngineResult:
         """Sample the posterior (a sampler) or minimise the objective (an optimizer)."""
         raise NotImplementedError

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...errors import SpacepolError
 from .base import OPTIMIZER, SAMPLER, Engine
-from .nlopt_engine import NLOPT_ALGORITHMS
+from .nlopt_engine import NLOPT_ALGORITHMS, check_algorithm
 
 
 class Emcee(Engine):
@@ -113,7 +113,12 @@ class Nlopt(Engine):
 
     name, kind = "nlopt", OPTIMIZER
     description = "an nlopt algorithm, nlopt:ALGO"
-    variants = tuple(NLOPT_ALGORITHMS)
+    variants = tuple(NLOPT_ALGORITHMS)  # the ones compare runs; any global (G*) algorithm of nlopt is taken
+
+    @classmethod
+    def check_variant(cls, variant: str) -> None:
+        """Any of nlopt's global algorithms (``GN_...``, ``GD_...``)."""
+        check_algorithm(variant)
 
     def run(self, objective, rng, **options):
         """The algorithm's best point and search history."""

@@ -66,6 +66,8 @@ class Engine:
         start = time.perf_counter()
         rng = np.random.default_rng(seed)
         self.check_options(options)
+        if "progress" in inspect.signature(self.run).parameters:
+            options = {"progress": progress, **options}
         draws = self.run(posterior, rng, **options)
         _check_draws(self.label, draws, posterior)
         return result_of(posterior, draws, rng, seed, start, engine=self.label)

@@ -1,5 +1,6 @@
 """The engines that ship with spacepol, each a small :class:`~.base.Engine` over its module: samplers ``emcee``
-(default), ``laplace`` (Laplace approximation corrected by importance sampling) and ``nuts`` (numpyro); optimizers
+(default), ``laplace`` (Laplace approximation corrected by importance sampling), ``nuts`` (numpyro) and ``nested``
+(nautilus, with the evidence); optimizers
 ``ga`` (the paper's), ``de`` (scipy) and ``nlopt:ALGO``."""
 
 from __future__ import annotations
@@ -82,6 +83,22 @@ class Nuts(Engine):
                            target_accept=target_accept, progress=progress, model_name=posterior.likelihood.model.name)
 
 
+class Nested(Engine):
+    """Nested sampling (nautilus): the posterior and the evidence ln Z with its error from independent replicates
+    (``engines.nested``)."""
+
+    name, kind = "nested", SAMPLER
+    description = "nested sampling (nautilus): posterior and log evidence with its error"
+
+    def run(self, posterior, rng, live: int = 500, replicates: int = 3, networks: int = 1, effective_draws: int = 4000,
+            progress: bool = False):
+        """Draws and ln Z (``engines.nested.sample_nested``)."""
+        from .nested import sample_nested
+
+        return sample_nested(posterior, rng, live=live, replicates=replicates, networks=networks,
+                             effective_draws=effective_draws, progress=progress)
+
+
 class GeneticAlgorithm(Engine):
     """The paper's genetic algorithm on the prior cube (``engines.ga.run_ga``)."""
 
@@ -127,4 +144,4 @@ class Nlopt(Engine):
         return run_nlopt(objective, self.variant, rng, **options)
 
 
-BUILTIN_ENGINES = (Emcee, Laplace, Nuts, GeneticAlgorithm, DifferentialEvolution, Nlopt)
+BUILTIN_ENGINES = (Emcee, Laplace, Nuts, Nested, GeneticAlgorithm, DifferentialEvolution, Nlopt)

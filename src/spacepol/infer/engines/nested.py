@@ -1,0 +1,85 @@
+"""Nested sampling with nautilus (Lange 2023, MNRAS 525, 3181): the posterior and the Bayesian evidence ln Z.
+
+Chosen over dynesty by measurement (``benchmarks/nested_choice.py``, figures in the README): on the paper's
+posterior nautilus gave more effective draws per second, evaluating the likelihood in the batches the compiled
+likelihood is built for.
+
+nautilus reports no error for ln Z, and the sampling error within its shells is smaller than the scatter of ln Z
+between seeds (the shells' volumes are estimated too). So the engine runs ``replicates``
+independent searches (seeds from the Generator) and reports ln Z as the log of their mean evidence with the
+standard error of the mean from their scatter. Each replicate's weighted points are resampled into one chain of
+about its effective size, so R-hat between replicates checks that they found the same posterior.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.special import logsumexp
+
+from ..engine_result import EngineResult
+
+
+def replicate_draws(points, log_w, rng: np.random.Generator, size: int) -> np.ndarray:
+    """``size`` indices of equally weighted draws from weighted points (systematic resampling)."""
+    w = np.exp(log_w - logsumexp(log_w))
+    positions = (rng.random() + np.arange(size)) / size
+    return np.minimum(np.searchsorted(np.cumsum(w), positions), len(points) - 1)
+
+
+def combine_evidence(log_z: np.ndarray) -> tuple[float, float]:
+    """(ln of the mean evidence, its standard error) of independent replicates' ln Z."""
+    log_z = np.asarray(log_z, float)
+    mean = float(logsumexp(log_z) - np.log(log_z.size))
+    z = np.exp(log_z - mean)  # relative to the mean: the SE of ln(mean Z) is SE(Z)/mean Z
+    return mean, float(np.std(z, ddof=1) / np.sqrt(z.size)) if z.size > 1 else float("nan")
+
+
+def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicates: int = 3, networks: int = 1,
+                  effective_draws: int = 4000, max_draws_per_replicate: int = 2000, progress: bool = False) -> EngineResult:
+    """``replicates`` nautilus runs with ``live`` live points and ``networks`` networks, each until
+    ``effective_draws`` effective draws; draws (per replicate at most ``max_draws_per_replicate``) and ln Z."""
+    import sys
+
+    from nautilus import Sampler
+
+    start = time.perf_counter()
+    priors = posterior.priors
+
+    def log_likelihood(theta):
+        value = posterior.log_likelihood(np.atleast_2d(theta))
+        return np.where(np.isfinite(value), value, -1e300)  # nautilus needs finite numbers
+
+    chains, log_z, effective, calls = [], [], [], 0
+    for r in range(replicates):
+        sampler = Sampler(priors.rescale, log_likelihood, n_dim=priors.ndim, n_live=live, n_networks=networks,
+                          vectorized=True, seed=int(rng.integers(2**31)))
+        sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False)
+        points, log_w, log_l = sampler.posterior()
+        w = np.exp(log_w - logsumexp(log_w))
+        effective.append(float(1.0 / np.sum(w**2)))
+        log_z.append(float(sampler.log_z))
+        calls += int(sampler.n_like)
+        chains.append((points, log_w, log_l))
+        if progress:
+            print(f"  nested sampling {r + 1}/{replicates}: ln Z {sampler.log_z:.3f}, {effective[-1]:.0f} effective draws, "
+                  f"{time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
+    per_chain = int(min(max_draws_per_replicate, min(effective)))
+    samples, log_prob = [], []
+    for points, log_w, log_l in chains:
+        idx = replicate_draws(points, log_w, rng, per_chain)
+        rng.shuffle(idx)
+        samples.append(points[idx])
+        log_prob.append(log_l[idx] + priors.ln_prob(points[idx]))
+    samples, log_prob = np.stack(samples, axis=1), np.stack(log_prob, axis=1)  # (draws, chains, D), (draws, chains)
+    value, error = combine_evidence(log_z)
+    best = samples.reshape(-1, priors.ndim)[int(np.argmax(log_prob))]
+    return EngineResult(method="nested", model=posterior.likelihood.model.name, names=list(posterior.names),
+                        best=dict(zip(posterior.names, map(float, best))), objective=-float(log_prob.max()),
+                        objective_name="negative_log_posterior", n_evaluations=calls,
+                        seconds=time.perf_counter() - start, seed=-1, samples=samples, log_prob=log_prob,
+                        info={"sampler": "nautilus", "live": live, "replicates": replicates, "networks": networks,
+                              "log_evidence": value, "log_evidence_error": error, "log_evidence_replicates": log_z,
+                              "effective_draws_per_replicate": effective, "draws_per_replicate": per_chain,
+                              "likelihood_calls": calls})

@@ -102,6 +102,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--engine", default="emcee", metavar="NAME",
                    help="the sampler: emcee (default), laplace, nuts, an entry point of group spacepol.engines, or "
                         "path/to/engine.py:Name")
+    p.add_argument("--engine-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="an option of the engine's run (e.g. replicates=5 for nested; repeatable)")
     p.add_argument("--restart", action="store_true",
                    help="start the chain afresh; an existing chain.h5 is kept aside as chain.h5.old")
     p.add_argument("--robust", action="store_true", help="Student-t likelihood (nu = 4) instead of Gaussian")

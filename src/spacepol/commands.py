@@ -138,6 +138,27 @@ def parse_references(items) -> dict[str, float]:
     return refs
 
 
+def parse_engine_options(items) -> dict:
+    """``["replicates=5", "live=300"]`` -> {"replicates": 5, "live": 300}: whole numbers as int, other numbers as
+    float, true/false as bool, the rest as text; the engine checks the names."""
+    options = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise ParameterError(f"--engine-option '{item}': expected KEY=VALUE")
+        value: object = text
+        for convert in (int, float):
+            try:
+                value = convert(text)
+                break
+            except ValueError:
+                continue
+        if text.lower() in ("true", "false"):
+            value = text.lower() == "true"
+        options[name.strip()] = value
+    return options
+
+
 def run(args) -> int:
     """``invert-mcmc run``: ``api.invert`` with the run's report; prints the findings and the convergence figures."""
     from .api import invert
@@ -149,7 +170,8 @@ def run(args) -> int:
     summary = invert(load_dataset(args), args.model, args.prior, args.engine, args.seed, args.out,
                      observables=args.observables, dispersion=args.dispersion, walkers=args.walkers, steps=args.steps,
                      robust=args.robust, restart=args.restart, progress=not args.quiet,
-                     references=parse_references(args.reference)).summary
+                     references=parse_references(args.reference),
+                     engine_options=parse_engine_options(args.engine_option)).summary
     for flag in summary["identifiability"].get("at_bound", []):
         from .infer.identifiability import bound_finding
 

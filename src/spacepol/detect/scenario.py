@@ -60,6 +60,10 @@ PAPER_CASES = [  # Table 3: "A" is the zenith angle, "E" the azimuth (row 2's az
 
 @dataclass
 class Scenario:
+    """A detection scenario, checked: ``site`` (latitude, longitude, time), ``sky`` (model, P_max range),
+    ``target`` (geometry, wavelength), ``instrument`` (Table 2's radiometry), the ``cases`` (directions on the
+    sky) and ``source`` (the file it came from, or the paper's default)."""
+
     site: dict
     sky: dict
     target: dict

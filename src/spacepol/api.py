@@ -337,16 +337,16 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
         scenario = read_scenario(scenario)
     elif isinstance(scenario, dict):
         scenario = scenario_from_dict(scenario)
-    if out is None:
-        content, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
-        return Contrast(content, per_case)
-    from .io.output import check_output_dir
-    from .report.contrast_report import assumptions, write_contrast_report
+    if out is not None:
+        from .io.output import check_output_dir
 
-    out = check_output_dir(Path(out))
+        out = check_output_dir(Path(out))  # before the work
     content, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
-    write_contrast_report(content, dict(per_case), out, result.summary["model"],
-                          assumptions(result.summary, scenario, content["material"]))
+    if out is not None:
+        from .report.contrast_report import assumptions, write_contrast_report
+
+        write_contrast_report(content, dict(per_case), out, result.summary["model"],
+                              assumptions(result.summary, scenario, content["material"]))
     return Contrast(content, per_case)
 
 

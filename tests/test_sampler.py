@@ -1,12 +1,10 @@
-"""emcee engine: resuming, prior-only sampling, recovery, calibration (SBC) and its negative control."""
+"""emcee engine: resuming, prior-only sampling, recovery and its negative control (SBC: tests/test_calibration.py)."""
 
 import numpy as np
 import pytest
 
 from spacepol.infer.engines.emcee_sampler import sample_emcee
 from spacepol.infer.posterior import Posterior
-from spacepol.infer.prior_set import PriorSet
-from spacepol.priors import Fixed, Uniform
 from spacepol.io.measurements import Dataset
 from spacepol.physics import Model
 
@@ -97,7 +95,7 @@ def _binomial_upper(trials, p=0.1, tail=0.002):
     return int(stats.binom.ppf(1 - tail, trials, p))
 
 
-@pytest.mark.slow  # 65 s; calibration in the default run: test_sbc_fast_calibrated and its negative control
+@pytest.mark.slow  # 65 s; calibration in the default run: tests/test_calibration.py (SBC) and its negative control
 def test_recovery_90_percent_intervals_cover_the_truth():
     """DOP + BRDF data (which separate k_s from rho_d): every parameter is identifiable.
 
@@ -127,64 +125,3 @@ def test_recovery_check_fails_for_a_wrong_truth():
     wrong = {k: v * 1.2 for k, v in truth.items()}
     cover = _covers(res, wrong)
     assert sum(not c for c in cover.values()) > _binomial_upper(len(cover)) , cover
-
-
-# --- simulation-based calibration -------------------------------------------------------
-SBC_PRIORS = {"n": Uniform(1.2, 2.0), "sigma": Uniform(0.1, 0.4), "k": Fixed(0.0), "ks": Fixed(1.0)}
-
-
-def _sbc(replicates, seed, noise_scale_in_likelihood=1.0, steps=700, walkers=16):
-    """Draw truth from the prior, simulate, sample; return rank of truth and 90 % coverage per replicate."""
-    rng = np.random.default_rng(seed)
-    model = Model.from_string("specular+smith")
-    ranks, covered = [], []
-    priors = PriorSet(model.parameters, SBC_PRIORS)
-    for _ in range(replicates):
-        truth = {"n": float(SBC_PRIORS["n"].sample(rng)), "sigma": float(SBC_PRIORS["sigma"].sample(rng)), "k": 0.0, "ks": 1.0}
-        data = synthetic("specular+smith", truth, n_theta_i=(25, 55), n_r=6, dop_err=0.02, brdf_rel=0.1,
-                         seed=int(rng.integers(2**31)))
-        if noise_scale_in_likelihood != 1.0:  # the deliberately wrong likelihood of the negative control
-            data.dop_err = data.dop_err * noise_scale_in_likelihood
-            data.brdf_err = data.brdf_err * noise_scale_in_likelihood
-        post = Posterior.build(data, model, {k: v for k, v in SBC_PRIORS.items()})
-        res = sample_emcee(post, rng, walkers=walkers, max_steps=steps, min_steps=10**9, check_every=steps,
-                           progress=False, initial="prior")
-        flat = res.flat_samples()
-        cover = _covers(res, truth)
-        covered.append([cover[n] for n in ("n", "sigma")])
-        ranks.append([np.mean(flat[:, j] < truth[name]) for j, name in enumerate(res.names)])
-    assert priors.names == ["n", "sigma"]
-    return np.array(ranks), np.array(covered)
-
-
-def _coverage_band(replicates, p=0.9, z=3.3):
-    """Binomial interval for the coverage of `replicates` calibrated 90 % intervals (z sigma)."""
-    sd = np.sqrt(p * (1 - p) / replicates)
-    return p - z * sd, min(1.0, p + z * sd)
-
-
-def test_sbc_fast_calibrated():
-    """Fast version: 24 replicates; coverage within the binomial band of a calibrated posterior."""
-    ranks, covered = _sbc(24, seed=101)
-    lo, hi = _coverage_band(24 * 2)
-    assert lo <= covered.mean() <= hi, covered.mean()
-    # ranks of the truth are uniform: KS test on all of them
-    from scipy import stats
-
-    assert stats.kstest(ranks.ravel(), "uniform").pvalue > 0.001
-
-
-def test_sbc_negative_control_fails_with_a_wrong_likelihood():
-    """The same check, with the likelihood told the noise is 3x smaller than it is: it must fail."""
-    ranks, covered = _sbc(24, seed=101, noise_scale_in_likelihood=1 / 3)
-    lo, _ = _coverage_band(24 * 2)
-    assert covered.mean() < lo, covered.mean()
-
-
-@pytest.mark.slow
-def test_sbc_slow_100_replicates():
-    """Acceptance: coverage of 90 % intervals within 80-97 % over >= 100 replicates."""
-    ranks, covered = _sbc(120, seed=2026, steps=1200, walkers=20)
-    coverage = covered.mean(axis=0)
-    print(f"SBC coverage of 90 % intervals over 120 replicates: n {coverage[0]:.3f}, sigma {coverage[1]:.3f}")
-    assert np.all((coverage >= 0.80) & (coverage <= 0.97)), coverage

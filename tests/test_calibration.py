@@ -1,0 +1,86 @@
+"""Simulation-based calibration (``spacepol.infer.calibration``): the statistics on known ranks, emcee calibrated
+on a small problem (fast), its negative control (a likelihood told the noise is 3x smaller than it is must fail),
+and every sampling engine over 100 replicates (slow; ``benchmarks/sbc_engines.py`` prints the figures)."""
+
+import numpy as np
+import pytest
+
+from spacepol.infer.calibration import LEVELS, Calibration, calibrate
+from spacepol.physics import Model
+from spacepol.physics.geometry import Geometry
+from spacepol.priors import Fixed, Uniform
+
+PRIORS = {"n": Uniform(1.2, 2.0), "sigma": Uniform(0.1, 0.4), "k": Fixed(0.0), "ks": Fixed(1.0)}
+MODEL = "specular+smith"
+
+
+def _geometry():
+    theta_i = np.repeat([25.0, 55.0], 6)
+    return Geometry(theta_i, np.tile(np.linspace(5, 75, 6), 2), np.full(theta_i.size, 180.0))
+
+
+def _calibrate(engine, replicates, seed, scale=1.0, **options):
+    return calibrate(engine, Model.from_string(MODEL), PRIORS, _geometry(), replicates, np.random.default_rng(seed),
+                     engine_options=options, noise_dop=0.02, noise_brdf=0.1, likelihood_noise_scale=scale)
+
+
+def _record(ranks, inside):
+    """A Calibration of known ranks (no sampling): ``inside`` per level from the ranks' own quantile."""
+    ranks = np.asarray(ranks)
+    return Calibration(engine="known", names=("a", "b"), truths=np.zeros_like(ranks, float), ranks=ranks,
+                       inside={level: inside(ranks, level) for level in LEVELS})
+
+
+def _central(ranks, level):
+    u = ranks / 99.0
+    return (u >= (1 - level) / 2) & (u <= (1 + level) / 2)
+
+
+def test_the_statistics_pass_uniform_ranks_and_fail_too_narrow_or_biased_ones():
+    """Uniform ranks (a calibrated engine) pass; a too narrow engine (ranks at both ends: the truth too often outside
+    its draws) and a biased one (ranks tilted) fail on the coverage or the histogram."""
+    rng = np.random.default_rng(0)
+    uniform = _record(rng.integers(0, 100, (400, 2)), _central)
+    assert uniform.calibrated, uniform.failures()
+    assert abs(uniform.coverage(0.9)[0] - 0.9) < 0.05
+    u = rng.uniform(size=(400, 2))
+    narrow = _record(np.round(99 * np.where(u < 0.5, u**3 * 4, 1 - (1 - u) ** 3 * 4)).clip(0, 99), _central)
+    assert not narrow.calibrated and any("intervals hold the truth" in f for f in narrow.failures())
+    biased = _record(np.round(99 * rng.uniform(size=(400, 2)) ** 1.6), _central)
+    assert any("ranks not uniform" in f for f in biased.failures()), biased.failures()
+    assert uniform.figure().axes and uniform.to_json()["calibrated"] is True
+
+
+def test_emcee_is_calibrated_on_a_small_problem():
+    """Fast version (12 replicates): the 50 % and 90 % intervals hold the truth within their binomial bands and the
+    ranks are uniform."""
+    c = _calibrate("emcee", 12, seed=101, max_steps=2000)
+    assert c.replicates == 12 and c.refused == 0
+    assert c.calibrated, c.failures()
+
+
+def test_emcee_with_a_wrong_noise_in_the_likelihood_fails_calibration():
+    """Negative control: the same data, the likelihood told the noise is 3x smaller than it is."""
+    c = _calibrate("emcee", 12, seed=101, scale=1 / 3, max_steps=2000)
+    assert not c.calibrated
+    lo, _ = c.coverage_band(0.9)
+    assert np.all(c.coverage(0.9) < lo), c.coverage(0.9)
+
+
+SLOW_OPTIONS = {
+    "emcee": {"max_steps": 3000},
+    "laplace": {},
+    "nested": {"live": 100, "replicates": 1, "effective_draws": 500},
+    "nuts": {"chains": 2, "warmup": 200, "draws": 250, "max_draws": 250},
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", sorted(SLOW_OPTIONS))
+def test_every_sampling_engine_is_calibrated_over_100_replicates_and_its_negative_control_fails(engine):
+    """Acceptance (issue 25, item 5): 100 replicates per engine; 30 with the wrong noise must fail."""
+    c = _calibrate(engine, 100, seed=2026, **SLOW_OPTIONS[engine])
+    print(engine, c.to_json()["parameters"])
+    assert c.replicates >= 95 and c.calibrated, c.failures()
+    control = _calibrate(engine, 30, seed=2026, scale=1 / 3, **SLOW_OPTIONS[engine])
+    assert not control.calibrated

@@ -3,6 +3,7 @@
 Targets: <= 300 s at one wavelength, <= 600 s at two (median of 3, on this machine).
 
     python benchmarks/diagnose_rounds_speed.py [--repeats 3] [--wavelengths 0.633 0.633,1.064] [--rounds 4] [--progress]
+                                               [--workers 2]
 
 The set: NIST's PTFE (data/ptfe), every k-th geometry plus every row of a reciprocal pair (so the set measures its
 own noise), at 0.633 um and at 0.633 + 1.064 um: 15 normalised Mueller elements and the BRDF per geometry. From
@@ -25,7 +26,7 @@ import numpy as np
 TARGETS_S = {1: 300.0, 2: 600.0}
 
 
-def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress: bool = False) -> None:
+def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress: bool = False, workers: int = 1) -> None:
     from spacepol import configure_process
 
     configure_process(small_calls=True)  # as the command line runs
@@ -47,7 +48,7 @@ def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress:
 
         model = SpectralModel(model, np.unique(data.wavelength_um))
     start = time.perf_counter()
-    out = diagnose_rounds(data, model, np.random.default_rng(seed), rounds, seed=seed, progress=progress)
+    out = diagnose_rounds(data, model, np.random.default_rng(seed), rounds, seed=seed, progress=progress, workers=workers)
     wall = time.perf_counter() - start
     print(json.dumps({"wall": wall, "rows": len(data), "numbers": 16 * len(data), "seconds": out["seconds"],
                       "path": [r["change"] or r["model"] for r in out["rounds"]], "final": out["final_model"],
@@ -62,11 +63,12 @@ def main():
     ap.add_argument("--wavelengths", nargs="+", default=["0.633", "0.633,1.064"])
     ap.add_argument("--warm", action="store_true", help="one JAX cache folder for all repeats")
     ap.add_argument("--progress", action="store_true", help="each repeat's progress lines on stderr (where the time goes)")
+    ap.add_argument("--workers", type=int, default=1, help="candidates fitted at once (diagnose --workers)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         wavelengths, seed = args.child.split(":")
-        child([float(w) for w in wavelengths.split(",")], args.rounds, int(seed), args.size, args.progress)
+        child([float(w) for w in wavelengths.split(",")], args.rounds, int(seed), args.size, args.progress, args.workers)
         return
     load = os.getloadavg()
     with tempfile.TemporaryDirectory() as scratch:
@@ -76,7 +78,7 @@ def main():
                 cache = os.path.join(scratch, "cache" if args.warm else f"cache-{spec}-{seed}")
                 env = {**os.environ, "SPACEPOL_CACHE_DIR": cache}
                 done = subprocess.run([sys.executable, __file__, "--child", f"{spec}:{seed}", "--rounds", str(args.rounds),
-                                       "--size", str(args.size)] + ["--progress"] * args.progress, env=env,
+                                       "--size", str(args.size), "--workers", str(args.workers)] + ["--progress"] * args.progress, env=env,
                                       stdout=subprocess.PIPE, stderr=None if args.progress else subprocess.PIPE, text=True)
                 if done.returncode:
                     sys.exit(f"repeat {seed} at {spec} um failed:\n{(done.stderr or '')[-3000:]}")
@@ -93,7 +95,7 @@ def main():
             print(f"{spec} um: median {median:.1f} s (range {min(walls):.1f}-{max(walls):.1f}) over {len(walls)} repeats, "
                   f"{'warm' if args.warm else 'cold'} JAX cache; target {TARGETS_S[n]:.0f} s: ratio {median / TARGETS_S[n]:.2f}",
                   flush=True)
-    print(f"load average before/after {load[0]:.2f}/{os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    print(f"load average before/after {load[0]:.2f}/{os.getloadavg()[0]:.2f} on {os.cpu_count()} cores, {args.workers} worker(s)")
 
 
 if __name__ == "__main__":

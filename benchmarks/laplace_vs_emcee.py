@@ -28,7 +28,7 @@ def main():
     from spacepol import configure_process
 
     configure_process(small_calls=True)  # as the command line runs
-    from spacepol.criticism.diagnose import ELPD_DRAWS, ELPD_TAU_MULTIPLE
+    from spacepol.criticism.candidate_fits import ELPD_DRAWS, ELPD_TAU_MULTIPLE
     from spacepol.infer.inversion import invert, invert_laplace
     from spacepol.infer.measured_noise import reciprocal_pairs
     from spacepol.infer.optimum import find_optimum

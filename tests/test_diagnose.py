@@ -114,7 +114,8 @@ def test_diagnose_prior_file_applies_to_candidates_and_rejects_unknown_names(tmp
 
 
 def test_prior_overrides_reach_the_models_that_have_the_parameter():
-    from spacepol.criticism.diagnose import _build, check_prior_names
+    from spacepol.criticism.candidate_fits import _build
+    from spacepol.criticism.diagnose import check_prior_names
     from spacepol.errors import SpacepolError
     from spacepol.priors import Fixed, Uniform
     from spacepol.physics import Model
@@ -205,3 +206,35 @@ def test_a_refit_whose_chain_did_not_converge_is_said_so():
     stuck = posterior_quality(fit(None, 1.13, 147.0, 8000))
     assert not stuck["converged"] and stuck["steps"] == 8000 and stuck["engine"] == "emcee"
     assert not posterior_quality(fit(None, 1.005, 120.0, 8000))["converged"]  # R-hat alone is not enough
+
+
+def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
+    """diagnose --workers: candidates screened, searched and refitted in two worker processes give the ranking the
+    same seed gives in one process, number for number (each task draws its own seed in candidate order); control:
+    another seed does change the screening gains, so the comparison can see a difference."""
+    from spacepol.criticism.hidden_effects import suite
+
+    case = next(c for c in suite() if c.effect == "polarized_diffuse")
+    candidates = ["polarized_diffuse", "extinction", "dop_bias"]
+
+    def ranking(workers, seed=case.seed):
+        from spacepol.criticism.diagnose import diagnose
+        from spacepol.criticism.hidden_effects import BASE, measurement
+        from spacepol.physics import Model
+
+        report = diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(seed), seed=0,
+                          candidates=candidates, top=2, progress=False, workers=workers)
+        return {e["change"]: (e["screening_gain"], e["delta_elpd"]) for e in report["ranking"]}, report["verdict"]
+
+    one, verdict_one = ranking(1)
+    two, verdict_two = ranking(2)
+    assert verdict_one == verdict_two == "polarized_diffuse"
+    assert one.keys() == two.keys()
+    for change in one:
+        (gain_one, elpd_one), (gain_two, elpd_two) = one[change], two[change]
+        assert gain_one == pytest.approx(gain_two, rel=1e-9, abs=1e-9), change
+        assert (elpd_one is None) == (elpd_two is None), change
+        if elpd_one is not None:
+            assert elpd_one == pytest.approx(elpd_two, rel=1e-9, abs=1e-9), change
+    other, _ = ranking(1, seed=case.seed + 1)
+    assert any(abs(other[c][0] - one[c][0]) > 1e-6 for c in one), (one, other)

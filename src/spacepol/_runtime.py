@@ -154,6 +154,15 @@ def configure_process(small_calls: bool = False) -> None:
     configure_jax()
     if small_calls:
         inline_small_calls()
+    _CONFIGURED.append(small_calls)
+
+
+_CONFIGURED: list[bool] = []  # the calls of configure_process in this process
+
+
+def configured() -> bool:
+    """Whether this process called ``configure_process`` (worker processes it starts then call it too)."""
+    return bool(_CONFIGURED)
 
 
 def ensure_double_precision() -> None:

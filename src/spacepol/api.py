@@ -478,13 +478,17 @@ class Diagnosis:
 
 def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None, top: int = 3, prior=None,
              observables=None, dispersion=None, posterior: str = "laplace", seed: int = 0, out=None,
-             json_path=None, wavelength_um=None, in_plane: bool = False) -> Diagnosis:
+             json_path=None, wavelength_um=None, in_plane: bool = False, workers: int = 1,
+             criterion: str = "loo") -> Diagnosis:
     """Which physical effect is missing or wrong: every candidate change (add, remove or replace an effect) is
     screened and the ``top`` ones refitted and compared by PSIS-LOO. ``rounds``: apply the best change and diagnose
     again, up to that many times. ``posterior``: ``laplace`` (importance-corrected, emcee where it cannot be
     trusted) or ``emcee`` for every refit. With ``out`` the figures and report.html are written there, with
     ``json_path`` the JSON record. ``data``: a Dataset, or a file read (after every other argument is checked) with
-    ``wavelength_um`` and ``in_plane`` as ``load`` reads it."""
+    ``wavelength_um`` and ``in_plane`` as ``load`` reads it. ``workers``: candidates searched and refitted at once,
+    each in its own process (the answer does not depend on it). ``criterion``: ``loo`` (delta ELPD-LOO) or
+    ``evidence`` (ln Bayes factor) ranks the refitted changes; each entry holds both where both are known."""
+    from .criticism.diagnose import CRITERIA
     from .criticism.diagnose import diagnose as run_diagnose
     from .io.output import check_output_dir, check_output_file
     from .physics.registry import registry
@@ -501,6 +505,10 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
         raise ParameterError(f"--top {top}: need at least 1")
     if posterior not in ("laplace", "emcee"):
         raise UnknownNameError(f"--posterior {posterior}: unknown (laplace, emcee)")
+    if criterion not in CRITERIA:
+        raise UnknownNameError(f"--criterion {criterion}: unknown ({', '.join(CRITERIA)})")
+    if not isinstance(workers, int) or workers < 1:
+        raise ParameterError(f"--workers {workers}: need a whole number of at least 1")
     data = load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
     full_model = build_model(model, data, dispersion)  # over several wavelengths: n, k per wavelength
     fitted = parse_observables(observables)
@@ -509,13 +517,13 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
         from .criticism.rounds import as_rungs, diagnose_rounds
 
         content = diagnose_rounds(data, full_model, rng, rounds, seed=seed, observables=fitted, candidates=candidates,
-                                  top=top, priors=overrides, posterior_method=posterior)
+                                  top=top, priors=overrides, posterior_method=posterior, workers=workers, criterion=criterion)
         rungs = as_rungs(content)
         first = content.pop("_reports")[0]
         base, confirmed = first["_base"], first["_confirmed"]
     else:
         content = run_diagnose(data, full_model, rng, seed=seed, observables=fitted, candidates=candidates, top=top,
-                               priors=overrides, posterior_method=posterior)
+                               priors=overrides, posterior_method=posterior, workers=workers, criterion=criterion)
         base, confirmed = content.pop("_base"), content.pop("_confirmed")
         rungs = None
     if out is not None:

@@ -129,6 +129,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--top", type=_int_at_least(1), default=3, help="candidates confirmed by a full refit")
     p.add_argument("--rounds", type=_int_at_least(1), default=None, metavar="N",
                    help="accept the best significant change and continue from the changed model, up to N rounds")
+    p.add_argument("--criterion", choices=("loo", "evidence"), default="loo",
+                   help="what ranks the refitted changes: delta ELPD-LOO, or the ln Bayes factor (evidence from "
+                        "Laplace-IS where trusted, else nested sampling); both are reported where known")
+    p.add_argument("--workers", type=_int_at_least(1), default=1, metavar="N",
+                   help="candidates searched and refitted at once, each in its own process (at most the cores; the "
+                        "answer does not depend on it)")
     p.add_argument("--posterior", choices=("laplace", "emcee"), default="laplace",
                    help="each fit's posterior: a Laplace approximation corrected by importance sampling where its Pareto k "
                         "trusts it, else emcee (default), or emcee always")

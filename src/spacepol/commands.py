@@ -240,7 +240,8 @@ def diagnose(args) -> int:
     result = diagnose_data(args.data, args.model, rounds=args.rounds, candidates=args.candidates,
                            top=args.top, prior=args.prior, observables=args.observables,
                            dispersion=getattr(args, "dispersion", None), posterior=args.posterior, seed=args.seed,
-                           out=args.out, json_path=args.json, wavelength_um=args.wavelength_um, in_plane=args.in_plane)
+                           out=args.out, json_path=args.json, wavelength_um=args.wavelength_um, in_plane=args.in_plane,
+                           workers=args.workers, criterion=args.criterion)
     report = result.content
     lead = report["ranking"][0] if report["ranking"] else None
     print(f"verdict: {report['verdict']}" + (f" ({lead['change']}: delta ELPD {lead['delta_elpd']:+.1f} +- "

@@ -28,24 +28,17 @@ from ..errors import SpacepolError
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
-from ..infer.inversion import explains, invert, invert_laplace
-from ..infer.optimum import find_optimum, multistart, screen_optimum
+from ..infer.inversion import explains
+from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
-from .changes import changes, separating_measurement, start_points
+from .candidate_fits import CandidateFits, _build, fit_for_elpd
+from .changes import changes, separating_measurement
 
 
 def _first_sentence(text: str) -> str:
     return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."
-
-
-def _build(data, model, observables, priors):
-    """The posterior of ``model`` with those prior overrides that name its parameters (or nuisances)."""
-    probe = Posterior.build(data, model, observables=observables)
-    own = {p.name for p in probe.priors.parameters}
-    overrides = {k: v for k, v in (priors or {}).items() if k in own}
-    return Posterior.build(data, model, overrides, observables=observables) if overrides else probe
 
 
 def check_prior_names(data, model: Model, priors: dict, observables=None, candidates=None) -> None:
@@ -75,7 +68,8 @@ def _vector(values: dict, posterior) -> np.ndarray:
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
              priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
-             posterior_method: str = "laplace", searched: dict | None = None) -> dict:
+             posterior_method: str = "laplace", searched: dict | None = None, workers: int = 1,
+             fits: CandidateFits | None = None, criterion: str = "loo") -> dict:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
     ``base``: a Result of ``model`` on these data already at hand (it is not refitted); ``confirm``:
     change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
@@ -83,7 +77,20 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     ``posterior_method``: how each fit's posterior is drawn (``fit_for_elpd``); ``searched``: the maxima already
     found for models on these data with these priors ({``model_key``: (max log posterior, optimum by name)}), used
     instead of a search and filled by this call (diagnose --rounds passes one from round to round: removing the
-    effect a round added gives back the model it started from, and replacing it gives a model screened then)."""
+    effect a round added gives back the model it started from, and replacing it gives a model screened then);
+    ``workers``: how many candidates are searched and refitted at once, in worker processes (the answer does not
+    depend on it: ``candidate_fits``); ``fits``: a ``CandidateFits`` already open for these data (diagnose --rounds
+    keeps one for all its rounds), else one is opened and closed here; ``criterion``: what ranks the refitted
+    changes and calls them significant, ``loo`` (delta ELPD-LOO > 2 SE and > 4) or ``evidence`` (ln Bayes factor
+    > 3 and > 2 x its error; ln Z from Laplace-IS where trusted, else nested sampling). Each ranking entry holds
+    both differences where both are known."""
+    if criterion not in CRITERIA:
+        raise SpacepolError(f"--criterion {criterion}: unknown ({', '.join(CRITERIA)})")
+    if fits is None:
+        with CandidateFits(data, observables, priors, workers) as own:
+            return diagnose(data, model, rng, seed, observables, candidates, top, screening_evaluations, max_steps,
+                            progress, priors, base, confirm, simplifications, posterior_method, searched, fits=own,
+                            criterion=criterion)
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     searched = {} if searched is None else searched
@@ -102,20 +109,30 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
 
     if progress:
         _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
-    screened = []
-    for i, change in enumerate(all_candidates, start=1):
-        post = _build(data, change.model, observables, priors)
-        if model_key(change.model) not in searched:
-            new = [j for j, name in enumerate(post.priors.names) if name not in base_optimum]
-            best, theta = screen_optimum(post, rng, start_points(base_optimum, change, post), new, screening_evaluations)
-            searched[model_key(change.model)] = best, dict(zip(post.priors.names, theta))
-        best, optimum = searched[model_key(change.model)]
-        gain = best - base_best
-        screened.append({"effect": change.effect, "change": change.label, "_change": change, "model": change.model,
-                         "posterior": post, "screening_gain": float(gain), "optimum": _vector(optimum, post)})
+    posteriors = [fits.posterior(change.model) for change in all_candidates]
+    unsearched = [i for i, change in enumerate(all_candidates) if model_key(change.model) not in searched]
+
+    def screened_line(i: int, done: int) -> None:
         if progress:
-            _say(f"[screen {i}/{len(all_candidates)}] {change.label:<32s} max log posterior gain {gain:9.2f} "
+            gain = searched[model_key(all_candidates[i].model)][0] - base_best
+            _say(f"[screen {done}/{len(all_candidates)}] {all_candidates[i].label:<32s} max log posterior gain {gain:9.2f} "
                  f"({time.perf_counter() - clock['start']:.0f} s)")
+
+    done = 0
+    for i in [i for i in range(len(all_candidates)) if i not in unsearched]:
+        done += 1
+        screened_line(i, done)
+    jobs = [(all_candidates[i].model, posteriors[i], all_candidates[i], base_optimum, screening_evaluations)
+            for i in unsearched]
+    for j, found in fits.run("screen", jobs, rng):
+        searched[model_key(all_candidates[unsearched[j]].model)] = found
+        done += 1
+        screened_line(unsearched[j], done)
+    screened = []
+    for change, post in zip(all_candidates, posteriors):
+        best, optimum = searched[model_key(change.model)]
+        screened.append({"effect": change.effect, "change": change.label, "_change": change, "model": change.model,
+                         "posterior": post, "screening_gain": float(best - base_best), "optimum": _vector(optimum, post)})
     screened.sort(key=lambda c: -c["screening_gain"])
 
     clock["screening"] = time.perf_counter()
@@ -130,9 +147,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     simpler = [c for c in screened if c not in to_confirm and c["posterior"].ndim < base_post.ndim
                and c["screening_gain"] > -2 * MIN_DELTA_ELPD]
     to_confirm += simpler[:simplifications]
-    for c in to_confirm:
-        # screening searched near the base model; a refit starts from the best of that and a global multistart
-        value, theta = multistart(c["posterior"], rng)
+    # screening searched near the base model; a refit starts from the best of that and a global multistart
+    leaders = dict(fits.run("leader", [(c["model"], c["posterior"]) for c in to_confirm], rng))
+    for i, c in enumerate(to_confirm):
+        value, theta = leaders[i]
         if value > c["screening_gain"] + base_best:
             c.update(screening_gain=float(value - base_best), optimum=theta)
             searched[model_key(c["model"])] = value, dict(zip(c["posterior"].priors.names, theta))
@@ -145,25 +163,41 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(base.loo.get("p_loo", 0.0)))]
     to_confirm = [c for c in to_confirm if c not in decided]
     clock["leaders"] = time.perf_counter()
-    confirmed = []
-    for i, c in enumerate(to_confirm, start=1):
+    if progress and to_confirm:
+        _say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c['change'] for c in to_confirm)} "
+             f"({time.perf_counter() - clock['start']:.0f} s)")
+    # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
+    jobs = [(c["model"], c["posterior"], c["optimum"], seed, max_steps, posterior_method) for c in to_confirm]
+    refits = {}
+    for i, inv in fits.run("refit", jobs, rng):
+        refits[i] = inv
         if progress:
-            _say(f"[confirm {i}/{len(to_confirm)}] {c['change']}: posterior and PSIS-LOO "
-                 f"({time.perf_counter() - clock['start']:.0f} s)")
-        # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
-        fit_start = time.perf_counter()
-        inv = fit_for_elpd(c["posterior"], c["optimum"], seed, max_steps, posterior_method)
-        if progress and posterior_method == "laplace" and inv.summary["diagnostics"].get("engine") != "laplace-is":
             q = posterior_quality(inv)
-            _say(f"  the Laplace approximation was not trusted there: emcee took {time.perf_counter() - fit_start:.0f} s"
-                 + ("" if q["converged"] else f" and {_unconverged(q)}"))
+            how = ("Laplace-IS" if q["engine"] == "laplace-is" else "emcee (the Laplace approximation was not trusted)"
+                   + ("" if q["converged"] else f", which {_unconverged(q)}"))
+            _say(f"[confirm {len(refits)}/{len(to_confirm)}] {to_confirm[i]['change']}: {how}, "
+                 f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
+    confirmed = []
+    for i, c in enumerate(to_confirm):
+        inv = refits[i]
         diff = inv.loo["pointwise"] - base_loo
         c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
                  delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
                  rmse_dop_after=inv.summary["fit"]["rmse_dop"], signatures=signatures(base, inv, base_fit))
         c["significant"] = significant(c["delta_elpd"], c["delta_elpd_se"])
         confirmed.append(c)
-    confirmed.sort(key=lambda c: -c["delta_elpd"])
+    base_evidence = evidence_of(base, base_post, seed) if criterion == "evidence" else base.log_evidence
+    for c in confirmed:
+        own = evidence_of(c["inversion"], c["posterior"], seed) if criterion == "evidence" else c["inversion"].log_evidence
+        if own is not None and base_evidence is not None:
+            c["delta_log_evidence"] = own[0] - base_evidence[0]
+            c["delta_log_evidence_error"] = float(np.hypot(own[1], base_evidence[1]))
+        if criterion == "evidence":
+            c["significant"] = significant_evidence(c["delta_log_evidence"], c["delta_log_evidence_error"])
+    if criterion == "evidence":
+        confirmed.sort(key=lambda c: -c["delta_log_evidence"])
+    else:
+        confirmed.sort(key=lambda c: -c["delta_elpd"])
     if confirmed and confirmed[0]["significant"]:
         # changes that fit equally well (tied with the best): the one with fewer free parameters leads
         group = [c for c in confirmed if c["significant"] and (c is confirmed[0] or _tied(confirmed[0], c))]
@@ -175,9 +209,15 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     ranking = []
     for i, c in enumerate(confirmed):
         entry = {k: c[k] for k in ("effect", "change", "delta_elpd", "delta_elpd_se", "rmse_dop_after", "significant")}
+        entry["delta_log_evidence"] = c.get("delta_log_evidence")
+        entry["delta_log_evidence_error"] = c.get("delta_log_evidence_error")
         entry["explains_misfit"] = not _structured(c["inversion"].summary)
         entry["screening_gain"] = c["screening_gain"]
         entry["explanation"] = _explain(c, base)
+        if c.get("delta_log_evidence") is not None:
+            entry["explanation"] += (f" ln Bayes factor over the model {c['delta_log_evidence']:+.1f} +- "
+                                     f"{c['delta_log_evidence_error']:.1f}"
+                                     + (" (the criterion here)." if criterion == "evidence" else "."))
         entry["posterior"] = posterior_quality(c["inversion"])
         if not entry["posterior"]["converged"]:
             entry["explanation"] += (f" Its posterior {_unconverged(entry['posterior'])}: its delta ELPD-LOO is less "
@@ -209,7 +249,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                                               f"two are twins here; {sep} would separate them.")
     for entry, c in zip(ranking, confirmed):
         entry["free_parameters"] = c["posterior"].ndim
-    return {"model": model.name, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
+    return {"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
             "ranking": ranking, "verdict": verdict,
             "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
@@ -220,34 +260,6 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)},
             "_base": base, "_confirmed": confirmed}
-
-
-# diagnose's fits compare predictive accuracy (ELPD-LOO), which needs enough independent draws (ESS >= 400, R-hat
-# <= 1.01, both still required), not the 50 tau a run's reported posterior waits for (emcee's advice for a stable
-# tau itself); how far its delta ELPD lies from a 50-tau chain's is not yet measured
-ELPD_TAU_MULTIPLE = 20.0
-# PSIS-LOO of a candidate from at most this many draws (Vehtari et al. recommend >= 2,000 for a stable k-hat); a
-# 278-geometry full-Mueller fit kept ~9,000, and its log-likelihood, replicates and LOO took 22 s of each refit
-ELPD_DRAWS = 2000
-
-
-POSTERIOR_METHODS = ("laplace", "emcee")
-
-
-def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
-    """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
-    Laplace approximation corrected by importance sampling (``inversion.invert_laplace``), where its Pareto k
-    trusts it, else emcee; "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``, ``paper+lambertian``)
-    the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
-    (``benchmarks/laplace_vs_emcee.py``)."""
-    if posterior_method not in POSTERIOR_METHODS:
-        raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
-    if posterior_method == "laplace":
-        inv = invert_laplace(posterior, centre, seed=seed, draws=ELPD_DRAWS)
-        if inv is not None:
-            return inv
-    return invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
-                  tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS)
 
 
 def posterior_quality(inv) -> dict:
@@ -318,6 +330,28 @@ def _where(data, observed) -> str:
 
 
 MIN_DELTA_ELPD = 4.0
+
+
+# Bayes factors: ln B > 3 (B > 20) is "strong" evidence on Kass & Raftery's scale (JASA 90, 773 (1995))
+MIN_LOG_BAYES_FACTOR = 3.0
+CRITERIA = ("loo", "evidence")
+
+
+def significant_evidence(delta: float, error: float) -> bool:
+    """A change the evidence favours: ln Bayes factor > 3 (strong, Kass & Raftery 1995) and > 2 x its error."""
+    return bool(delta > MIN_LOG_BAYES_FACTOR and delta > 2 * error)
+
+
+def evidence_of(result, posterior, seed: int) -> tuple[float, float]:
+    """(ln Z, error) of a fit: its own where its engine gives one (Laplace-IS where its weights are trusted,
+    nested sampling), else from the ``nested`` engine on the same posterior."""
+    if result.log_evidence is not None:
+        return result.log_evidence
+    from ..infer.engine_registry import engines
+
+    nested = engines.get("nested").result(posterior, seed=seed)
+    result.summary["log_evidence"] = nested.summary["log_evidence"]
+    return nested.log_evidence
 
 
 def significant(delta: float, se: float) -> bool:

@@ -37,9 +37,12 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                 centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
             inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
         fit, noise = inv.summary["fit"], inferred_noise_levels(inv.summary)
+        evidence = rung_evidence(inv, seed)
         rungs.append({"model": current.name, "change": None if change is None else change.label,
                       "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
+                      "log_evidence": None if evidence is None else evidence[0],
+                      "log_evidence_error": None if evidence is None else evidence[1],
                       "inferred_noise": noise, "noise_known": not noise, "noise": inv.summary.get("noise", {}),
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"],
                       "pareto_k": inv.summary["diagnostics"].get("pareto_k"), "parameters": inv.summary["parameters"],
@@ -47,3 +50,17 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                       "residual_structure": inv.summary["residual_structure"]["findings"],
                       "_inversion": inv})
     return rungs
+
+
+def rung_evidence(result, seed: int) -> tuple[float, float] | None:
+    """A rung's (ln Z, error): the Result's own where its engine gave one, else Laplace-IS at its best point where
+    the importance weights are trusted (None where they are not: a ridge or a parameter at a bound; run the rung
+    with ``--engine nested`` for it)."""
+    if result.log_evidence is not None or result.posterior is None:
+        return result.log_evidence
+    from ..infer.laplace import laplace_importance
+
+    names = result.posterior.names
+    centre = np.array([result.draws.best[n] for n in names], float)
+    sample = laplace_importance(result.posterior, centre, np.random.default_rng(seed))
+    return sample.log_evidence if sample is not None and sample.reliable else None

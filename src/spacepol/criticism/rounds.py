@@ -12,6 +12,7 @@ import numpy as np
 from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels, misfit_words
 from ..physics.model import Model
 from .changes import changes, slot_alternatives
+from .candidate_fits import CandidateFits
 from .diagnose import _structured, diagnose, significant
 
 
@@ -42,10 +43,18 @@ def as_rungs(result: dict) -> list[dict]:
 
 def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, seed: int = 0, observables=None,
                     candidates=None, top: int = 3, progress: bool = True, priors: dict | None = None, base=None,
-                    posterior_method: str = "laplace") -> dict:
+                    posterior_method: str = "laplace", workers: int = 1, criterion: str = "loo") -> dict:
     """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
     ``conclusion`` over the whole path; ``_reports`` keeps each round's full report. ``posterior_method``: how
-    each fit's posterior is drawn (``diagnose.fit_for_elpd``)."""
+    each fit's posterior is drawn (``candidate_fits.fit_for_elpd``); ``workers``: candidates fitted at once, in
+    worker processes started once for all rounds; ``criterion``: ``loo`` or ``evidence`` (``diagnose``)."""
+    with CandidateFits(data, observables, priors, workers) as fits:
+        return _rounds(data, model, rng, rounds, seed, observables, candidates, top, progress, priors, base,
+                       posterior_method, fits, criterion)
+
+
+def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progress, priors, base, posterior_method,
+            fits, criterion="loo") -> dict:
     reports, current = [], model
     path = []
     searched = {}  # the maxima found for each model screened so far (diagnose's ``searched``)
@@ -54,7 +63,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
             print(f"  round {r + 1}/{rounds}: what is missing from {current.name}?", file=sys.stderr, flush=True)
         report = diagnose(data, current, rng, seed=seed, observables=observables, candidates=candidates, top=top,
                           progress=progress, priors=priors, base=base, simplifications=2, posterior_method=posterior_method,
-                          searched=searched)
+                          searched=searched, fits=fits, criterion=criterion)
         reports.append(report)
         if not path:
             path.append(_step(report["_base"].summary))
@@ -64,7 +73,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
             if simplification is None:
                 path[-1]["equivalent"], path[-1]["better"] = _slot_equivalents(
                     data, current, rng, seed, observables, candidates, progress, priors, report["_base"], posterior_method,
-                    searched)
+                    searched, fits)
                 break
         lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
@@ -93,7 +102,8 @@ def _simplification(report: dict):
 
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
-                      posterior_method: str = "laplace", searched: dict | None = None) -> tuple[list[dict], list[dict]]:
+                      posterior_method: str = "laplace", searched: dict | None = None,
+                      fits=None) -> tuple[list[dict], list[dict]]:
     """Where the path stopped: refit every other member of each of the final model's slots (and the slot
     emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
     the conclusion can say which parts of the final model the data pin down. Returns (equivalent, better): the
@@ -111,7 +121,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     known = set(base.posterior.names) | {p.name for c in changes(model, data, names) for p in c.model.parameters}
     report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=progress,
                       priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
-                      posterior_method=posterior_method, searched=searched)
+                      posterior_method=posterior_method, searched=searched, fits=fits)
     return _equivalent(report, labels), _better(report, labels)
 
 

@@ -112,8 +112,9 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     centre = np.asarray(centre, float)
     centre_value = float(posterior.log_prob(centre[None, :])[0])
     best = centre if centre_value >= sample.log_prob.max() else sample.theta[int(np.argmax(sample.log_prob))]
+    log_z, log_z_error = sample.log_evidence  # importance sampling's evidence, trusted where the weights are
     info = {"engine": "laplace-is", "draws": len(sample.theta), "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
-            "proposal": sample.proposal}
+            "proposal": sample.proposal, "log_evidence": log_z, "log_evidence_error": log_z_error}
     result = EngineResult(method="laplace-is", model=posterior.likelihood.model.name, names=names,
                     best=dict(zip(names, map(float, best))), objective=-float(max(centre_value, sample.log_prob.max())),
                     objective_name="negative_log_posterior", n_evaluations=posterior.n_evaluations,
@@ -158,7 +159,7 @@ def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: di
         "sampler": {k: v for k, v in result.info.items() if k not in ("tau", "start_search")} | {"tau": result.info.get("tau")},
         "pareto_k_bad": loo_result["pareto_k_bad"],
     }
-    if "log_evidence" in result.info:  # an engine that estimates the evidence (a nested sampler)
+    if "log_evidence" in result.info:  # an engine that estimates the evidence (nested sampling, Laplace-IS)
         summary["log_evidence"] = {"value": float(result.info["log_evidence"]),
                                    "error": float(result.info.get("log_evidence_error", np.nan))}
     if "start_search" in result.info:  # the modes the start-point searches found (infer.modes)

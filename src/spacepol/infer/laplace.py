@@ -103,6 +103,18 @@ class ImportanceSample:
         narrower than ``MIN_WIDTH_RATIO`` x its Laplace SD in the sampling space (``width_ratio``, the smallest ratio)."""
         return _trusted(self.pareto_k, self.effective_draws) and self.width_ratio >= MIN_WIDTH_RATIO
 
+    @property
+    def log_evidence(self) -> tuple[float, float]:
+        """(ln Z, its standard error): Z = the mean over the draws of p(theta, y) / q(theta), the unsmoothed weights
+        (draws where the posterior is zero count as zero), an unbiased estimate of the evidence, and the delta
+        method's error of its log. The weights' Pareto k bounds this estimate's variance as it bounds the posterior
+        moments': it is to be used where the sample is ``reliable`` (k <= 0.7; Vehtari et al. 2024, sec. 6)."""
+        raw = np.where(np.isnan(self.raw_log_weights), -np.inf, self.raw_log_weights)
+        top = float(np.max(raw))
+        w = np.exp(raw - top)
+        mean = float(np.mean(w))
+        return top + float(np.log(mean)), float(np.std(w) / (np.sqrt(len(w)) * mean))
+
     def resample(self, rng: np.random.Generator, draws: int | None = None) -> np.ndarray:
         """Indices of ``draws`` equally weighted draws (systematic resampling of the smoothed weights)."""
         draws = len(self.theta) if draws is None else draws

@@ -70,6 +70,11 @@ class Geometry:
         """The number of geometries."""
         return self.theta_i.shape[-1]
 
+    def __reduce__(self):
+        # sent to another process as its angles: the cached terms hold JAX arrays and a module reference
+        wavelength = None if self.wavelength_um is None else np.asarray(self.wavelength_um)
+        return Geometry, (np.asarray(self.theta_i), np.asarray(self.theta_r), np.asarray(self.dphi), wavelength)
+
     def cached(self, key, compute):
         """Memoise a parameter-free term (e.g. the paper's shadowing at fixed constants)."""
         if key not in self._cache:

@@ -55,6 +55,10 @@ class SpectralModel:
         self._geometries: dict = {}
 
     @property
+
+    def __getstate__(self):
+        # the per-geometry split is keyed by the geometry's id in this process: rebuilt where it is used
+        return {**self.__dict__, "_geometries": {}}
     def name(self) -> str:
         """The inner model's name (the wavelengths are in ``wavelengths``)."""
         return self.model.name

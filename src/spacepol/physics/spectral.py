@@ -54,11 +54,11 @@ class SpectralModel:
             raise ParameterError(f"--dispersion n=cauchy: model {model.name} has no n")
         self._geometries: dict = {}
 
-    @property
-
     def __getstate__(self):
         # the per-geometry split is keyed by the geometry's id in this process: rebuilt where it is used
         return {**self.__dict__, "_geometries": {}}
+
+    @property
     def name(self) -> str:
         """The inner model's name (the wavelengths are in ``wavelengths``)."""
         return self.model.name

@@ -104,6 +104,13 @@ def test_observables(capsys, here, observables, words):
     (["synth", "--set", "rho_d=1e300", "--out", "s.csv"], ["rho_d = 1e+300", "[0, 1]"]),
     (["forward", "good.csv", "--set", "n=1e300", "--out", "f.csv"], ["n = 1e+300", "no finite output"]),
     (["synth", "--set", "k=1e300", "--out", "s.csv"], ["k = 1e+300", "no finite output"]),
+    (["design", "good.csv", "--noise", "dop=-0.01"], ["--noise 'dop=-0.01'", "X > 0"]),
+    (["design", "good.csv", "--noise", "dop=inf"], ["--noise 'dop=inf'", "X > 0"]),
+    (["design", "good.csv", "--noise", "glitter=0.1"], ["--noise 'glitter=0.1'"]),
+    (["design", "good.csv", "--noise", "dop"], ["--noise 'dop'", "dop=X"]),
+    (["design", "good.csv", "--noise", "dop=lots"], ["--noise 'dop=lots'"]),
+    (["diagnose", "good.csv", "--json", "d.json", "--criterion", "bic"], ["--criterion", "bic"]),
+    (["diagnose", "good.csv", "--json", "d.json", "--workers", "0"], ["--workers"]),
 ])
 def test_numbers_that_must_be_finite_or_positive(capsys, here, args, words):
     expect_error(capsys, here, args, *words)

@@ -42,7 +42,7 @@ def here(tmp_path, monkeypatch):
     from spacepol.physics.registry import registry
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(registry, "_effects", dict(registry._effects))
+    monkeypatch.setattr(registry, "_classes", dict(registry._classes))
     (tmp_path / "good.csv").write_text(GOOD_CSV)
     (tmp_path / "a_file").write_text("x")
     return tmp_path

@@ -75,7 +75,7 @@ PLUGIN = textwrap.dedent('''
 
 @pytest.fixture
 def plugins(tmp_path, monkeypatch):
-    monkeypatch.setattr(registry, "_effects", dict(registry._effects))
+    monkeypatch.setattr(registry, "_classes", dict(registry._classes))
     path = tmp_path / "mine.py"
     path.write_text(PLUGIN)
     registry.load_file(f"{path}:FlatShadow")

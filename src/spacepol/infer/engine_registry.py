@@ -12,67 +12,38 @@ variant (the engine ``nlopt`` with the algorithm ``ALGO``).
 
 from __future__ import annotations
 
-import inspect
-from importlib.metadata import entry_points
-
 from ..errors import SpacepolError, UnknownNameError
+from ..plugins import PluginRegistry
 from .engine_result import EngineResult
 from .engines.base import OPTIMIZER, SAMPLER, Engine
 from .engines.builtin import BUILTIN_ENGINES
 
-class EngineRegistry:
+class EngineRegistry(PluginRegistry):
     """Engine classes by name: built-ins, the ``spacepol.engines`` entry points, files loaded by ``get``; where each
     plug-in came from in ``sources``."""
 
-    def __init__(self):
-        self._engines: dict[str, type[Engine]] = {}
-        self._entry_points_loaded = False
-        self.sources: dict[str, str] = {}
+    kind, base, group, option = "engine", Engine, "spacepol.engines", "--engine"
 
-    def register(self, cls: type[Engine]) -> type[Engine]:
-        """Add an engine class under its ``name`` (an Engine subclass with a name and a kind); returns the class."""
-        if not (inspect.isclass(cls) and issubclass(cls, Engine)):
-            raise SpacepolError(f"{cls!r} is not an Engine subclass (use spacepol.infer.engines.base.Engine)")
-        if not cls.name or ":" in cls.name:
+    def check_class(self, cls: type[Engine]) -> None:
+        """An engine's name has no ':' (that separates a variant) and its kind is a sampler or an optimizer."""
+        if ":" in cls.name:
             raise SpacepolError(f"engine class {cls.__name__} needs a 'name' without ':'")
         if cls.kind not in (SAMPLER, OPTIMIZER):
             raise SpacepolError(f"engine {cls.name}: kind '{cls.kind}' is neither '{SAMPLER}' nor '{OPTIMIZER}'")
-        known = self._engines.get(cls.name)
-        same = known is not None and (known.__module__, known.__qualname__) == (cls.__module__, cls.__qualname__)
-        if known is not None and known is not cls and not same:
-            raise SpacepolError(f"engine name '{cls.name}' is already registered by {known.__module__}.{known.__name__}")
-        self._engines[cls.name] = cls
-        return cls
-
-    def _load_entry_points(self) -> None:
-        if self._entry_points_loaded:
-            return
-        self._entry_points_loaded = True
-        for ep in entry_points(group="spacepol.engines"):
-            try:
-                self.sources[self.register(ep.load()).name] = f"entry point {ep.name}"
-            except Exception as exc:  # a broken plug-in is named, not hidden
-                raise SpacepolError(f"entry point '{ep.name}' ({ep.value}) of group spacepol.engines: {exc}") from exc
 
     def names(self, kind: str | None = None) -> list[str]:
         """Every engine's name (of one ``kind`` when given)."""
-        self._load_entry_points()
-        return [n for n, cls in self._engines.items() if kind is None or cls.kind == kind]
+        return [n for n, cls in self.classes().items() if kind is None or cls.kind == kind]
 
     def get(self, name: str, kind: str | None = None) -> Engine:
         """An engine instance for ``name`` (``emcee``, ``nlopt:LN_SBPLX``, ``path/to/file.py:Name``), of ``kind``
         when given; an unknown name, variant or kind is one line listing what there is."""
         if ".py:" in name:
-            from ..plugins import load_attribute
-
-            obj, source = load_attribute(name, "--engine", "spacepol_user_engine")
-            cls = self.register(obj)
-            self.sources[cls.name] = source
-            engine = cls()
+            engine = self.load_file(name)()
         else:
-            self._load_entry_points()
+            self.load_entry_points()
             base, _, variant = name.partition(":")
-            cls = self._engines.get(base)
+            cls = self._classes.get(base)
             if cls is None:
                 raise UnknownNameError(f"unknown engine '{name}' (known: {self._listing(kind)}; or path/to/file.py:Name)")
             if variant:
@@ -86,7 +57,7 @@ class EngineRegistry:
         return engine
 
     def _listing(self, kind: str | None) -> str:
-        return ", ".join(n + (":ALGO" if self._engines[n].variants else "") for n in self.names(kind))
+        return ", ".join(n + (":ALGO" if self._classes[n].variants else "") for n in self.names(kind))
 
 
 def _article(word: str) -> str:
@@ -102,7 +73,7 @@ def method_names() -> list[str]:
     """Every name ``optimize`` and ``compare`` take: the optimizers (nlopt with each algorithm) and the samplers."""
     names = []
     for name in engines.names():
-        cls = engines._engines[name]
+        cls = engines.classes()[name]
         names += [f"{name}:{v}" for v in cls.variants] if cls.variants else [name]
     return names
 

@@ -5,8 +5,8 @@ and every sampling engine over 100 replicates (slow; ``benchmarks/sbc_engines.py
 import numpy as np
 import pytest
 
-from spacepol.infer.calibration import LEVELS, Calibration, calibrate
-from spacepol.physics import Model
+import spacepol
+from spacepol.infer.calibration import LEVELS, Calibration
 from spacepol.physics.geometry import Geometry
 from spacepol.priors import Fixed, Uniform
 
@@ -20,8 +20,8 @@ def _geometry():
 
 
 def _calibrate(engine, replicates, seed, scale=1.0, **options):
-    return calibrate(engine, Model.from_string(MODEL), PRIORS, _geometry(), replicates, np.random.default_rng(seed),
-                     engine_options=options, noise_dop=0.02, noise_brdf=0.1, likelihood_noise_scale=scale)
+    return spacepol.calibrate(MODEL, PRIORS, _geometry(), engine=engine, replicates=replicates, seed=seed,
+                              engine_options=options, noise_dop=0.02, noise_brdf=0.1, likelihood_noise_scale=scale)
 
 
 def _record(ranks, inside):

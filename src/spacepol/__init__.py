@@ -27,7 +27,7 @@ _API = {
     "load": "api", "parse_wavelengths": "api", "build_model": "api", "build_posterior": "api",
     "parse_observables": "api", "invert": "api", "forward": "api", "synth": "api", "contrast": "api",
     "parameter_values": "api", "Contrast": "api", "sky": "api", "Sky": "api",
-    "diagnose": "api", "Diagnosis": "api", "ladder": "api", "Ladder": "api", "design": "api", "Design": "api",
+    "diagnose": "api", "Diagnosis": "api", "calibrate": "api", "Calibration": "infer.calibration", "ladder": "api", "Ladder": "api", "design": "api", "Design": "api",
     "Result": "infer.result", "Diagnostics": "infer.result", "Fit": "infer.result",
     "Dataset": "io.dataset", "Model": "physics.model", "Geometry": "physics.geometry",
     "SpacepolError": "errors",

@@ -297,6 +297,26 @@ def synth(model, values: dict | None = None, geometry=None, *, noise_dop: float 
                    source=str(out) if out is not None else "spacepol synth")
 
 
+def calibrate(model, priors: dict, geometry, *, engine: str = "emcee", replicates: int = 100, seed: int = 0,
+              engine_options: dict | None = None, noise_dop: float = 0.01, noise_brdf: float = 0.05,
+              mueller_noise: float | None = None, likelihood_noise_scale: float = 1.0, progress: bool = False):
+    """Simulation-based calibration of a sampling ``engine`` (``infer.calibration``): ``replicates`` truths from
+    ``priors`` ({name: Prior}; the model's defaults for the rest), data simulated at ``geometry`` (a Geometry, a
+    Dataset or a file of geometries) with Gaussian noise of known size, one run each. Returns a ``Calibration``:
+    coverage of the 50 % and 90 % intervals, rank histograms and their figure, ``calibrated``, ``failures``."""
+    from .infer.calibration import calibrate as run_sbc
+    from .io.measurements import read_measurements
+
+    if replicates < 1:
+        raise ParameterError(f"replicates {replicates}: need at least 1")
+    if isinstance(geometry, (str, Path)):
+        geometry = read_measurements(geometry, require_observable=False)
+    geometry = geometry.geometry if isinstance(geometry, Dataset) else geometry
+    return run_sbc(engine, build_model(model), priors, geometry, replicates, np.random.default_rng(seed),
+                   engine_options=engine_options, noise_dop=noise_dop, noise_brdf=noise_brdf,
+                   mueller_noise=mueller_noise, likelihood_noise_scale=likelihood_noise_scale, progress=progress)
+
+
 @dataclass
 class Contrast:
     """A run's posterior in a detection scenario (the paper's Table 3 as distributions): ``rows`` per case with

@@ -26,6 +26,16 @@ def _pick(ranking, key, error, rule):
     return max(best, key=lambda e: e[key])["change"] if best else "none"
 
 
+def _twins(a: str, b: str) -> bool:
+    """Whether two picks add effects that declare each other twins (equal fits on DOP and BRDF: LOO ties them)."""
+    from spacepol.physics.registry import registry
+
+    names = [label.split()[-1] for label in (a, b)]
+    if "none" in (a, b) or a == b:
+        return False
+    return names[1] in registry.get(names[0]).twins or names[0] in registry.get(names[1]).twins
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="default", help="'all', or how many of the default selection")
@@ -60,13 +70,14 @@ def main():
         evidence = _pick(ranking, "delta_log_evidence", "delta_log_evidence_error", significant_evidence)
         nested = sum(1 for e in ranking if e.get("posterior", {}).get("engine") not in (None, "laplace-is"))
         rows.append({"case": case.label, "hidden": case.effect or "none", "loo": loo, "evidence": evidence,
-                     "agree": loo == evidence, "refits_by_emcee_and_nested": nested,
+                     "agree": loo == evidence, "twins": _twins(loo, evidence), "refits_by_emcee_and_nested": nested,
                      "seconds": time.perf_counter() - t})
         points += [{"case": case.label, "change": e["change"], "delta_elpd": e["delta_elpd"], "se": e["delta_elpd_se"],
                     "delta_log_evidence": e["delta_log_evidence"], "error": e["delta_log_evidence_error"]}
                    for e in ranking if e.get("delta_log_evidence") is not None and e["delta_elpd"] is not None]
         print(f"[{k}/{len(cases)}] {case.label:<28s} LOO: {loo:<32s} evidence: {evidence:<32s} "
-              f"{'agree' if loo == evidence else 'DIFFER'} ({rows[-1]['seconds']:.0f} s)", flush=True)
+              f"{'agree' if loo == evidence else 'twins' if rows[-1]['twins'] else 'DIFFER'} ({rows[-1]['seconds']:.0f} s)",
+              flush=True)
     agree = sum(r["agree"] for r in rows)
     print(f"the two criteria pick the same change in {agree} of {len(rows)} cases; {time.perf_counter() - start:.0f} s; "
           f"load average after: {os.getloadavg()[0]:.2f}")
@@ -74,8 +85,8 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     (out / "criteria.json").write_text(json.dumps({"cases": rows, "refits": points}, indent=1))
     lines = ["| case | hidden | LOO picks | evidence picks | same |", "|---|---|---|---|---|"]
-    lines += [f"| {r['case']} | {r['hidden']} | {r['loo']} | {r['evidence']} | {'yes' if r['agree'] else '**no**'} |"
-              for r in rows]
+    lines += [f"| {r['case']} | {r['hidden']} | {r['loo']} | {r['evidence']} | "
+              f"{'yes' if r['agree'] else 'twins' if r['twins'] else '**no**'} |" for r in rows]
     lines.append(f"\nSame change in {agree} of {len(rows)} cases.")
     (out / "criteria.md").write_text("\n".join(lines) + "\n")
     fig = Figure(figsize=(5.5, 4.5), layout="constrained")

@@ -119,7 +119,7 @@ class Calibration:
             ax.set_xticks([])
         axes[0].set_ylabel(f"replicates (of {self.replicates})")
         axes[0].legend(fontsize=7, loc="lower center")
-        fig.suptitle(f"SBC of {self.engine}" + (f", likelihood noise x{self.likelihood_noise_scale:g}"
+        fig.suptitle(f"SBC of {self.engine}" + (f", likelihood noise x{self.likelihood_noise_scale:.3g}"
                                                 if self.likelihood_noise_scale != 1 else ""), fontsize=10)
         return fig
 

@@ -139,6 +139,7 @@ def _check_nested(data, prior, wider, reference, options):
     tolerance = 4 * np.hypot(error, expected_se)
     assert abs(log_z - expected) < tolerance
     assert max(_agree(result, reference).values()) < 4 and result.diagnostics.rhat_max < 1.01
+    assert "missed_mode" not in result.summary["sampler"]  # the control of the missed-mode check below
     other, _ = _importance_log_evidence(data, {**prior, "sigma": wider}, reference)
     assert abs(other - (expected - np.log(2))) < 4 * expected_se and abs(log_z - other) > tolerance
 
@@ -146,6 +147,30 @@ def _check_nested(data, prior, wider, reference, options):
 def test_nested_sampling_gives_the_evidence_and_the_posterior_fast(data, reference):
     """Two free parameters with narrow priors (few shells: about 17 s)."""
     _check_nested(data, NARROW, Uniform(0.235, 0.275), reference, {"live": 200, "replicates": 3, "effective_draws": 800})
+
+
+def test_nested_sampling_that_missed_the_best_mode_says_so(data, monkeypatch):
+    """The posterior's mode lies far above every draw nested sampling returned (its draws replaced here by draws
+    of the prior around n 1.52, 40 posterior SDs from the mode): the run says its ln Z covers only the modes it
+    found, in the summary and the report's verdict. The control (the true draws: nothing missed) is in the test
+    above."""
+    from spacepol.infer.engines import nested as nested_module
+
+    real = nested_module.sample_nested
+
+    def stranded(posterior, rng, **options):
+        draws = real(posterior, rng, **options)
+        far = draws.samples.copy()
+        far[..., posterior.names.index("n")] = 1.52 + 0.001 * rng.standard_normal(far.shape[:2])
+        draws.samples, draws.log_prob = far, posterior.log_prob(far.reshape(-1, far.shape[-1])).reshape(far.shape[:2])
+        return draws
+
+    monkeypatch.setattr(nested_module, "sample_nested", stranded)
+    result = spacepol.invert(data, "paper", prior=NARROW, engine="nested", seed=1,
+                             engine_options={"live": 100, "replicates": 2, "effective_draws": 300})
+    missed = result.summary["sampler"]["missed_mode"]
+    assert missed["log_posterior"] > missed["best_sampled"] + 4 and abs(missed["at"]["n"] - 1.6) < 0.02
+    assert "ln Z covers only the modes it found" in missed["finding"]
 
 
 @pytest.mark.slow

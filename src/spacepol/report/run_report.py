@@ -102,6 +102,8 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
                    "the intervals.")
     if s.get("log_evidence"):
         verdict += f" Log evidence ln Z = {s['log_evidence']['value']:.2f} +- {s['log_evidence']['error']:.2f}."
+    if s["sampler"].get("missed_mode"):
+        verdict += f" NOT the whole posterior: {s['sampler']['missed_mode']['finding']}."
     if s["sampler"].get("capped"):
         verdict += f" The chain hit the step cap ({s['sampler']['steps']} steps) before reaching 50 autocorrelation times."
     sections = [

@@ -5,6 +5,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ...errors import SpacepolError
@@ -93,10 +95,16 @@ class Nested(Engine):
     def run(self, posterior, rng, live: int = 500, replicates: int = 3, networks: int = 1, effective_draws: int = 4000,
             progress: bool = False):
         """Draws and ln Z (``engines.nested.sample_nested``)."""
-        from .nested import sample_nested
+        from .nested import missed_mode, sample_nested
 
-        return sample_nested(posterior, rng, live=live, replicates=replicates, networks=networks,
-                             effective_draws=effective_draws, progress=progress)
+        draws = sample_nested(posterior, rng, live=live, replicates=replicates, networks=networks,
+                              effective_draws=effective_draws, progress=progress)
+        missed = missed_mode(posterior, draws, rng)
+        if missed is not None:
+            draws.info["missed_mode"] = missed
+            if progress:
+                print(f"  {missed['finding']}", file=sys.stderr, flush=True)
+        return draws
 
 
 class GeneticAlgorithm(Engine):

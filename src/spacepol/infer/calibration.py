@@ -17,6 +17,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 
+import jax
 import numpy as np
 from scipy import stats
 
@@ -195,6 +196,10 @@ def calibrate(engine: str, model, priors: dict, geometry: Geometry, replicates: 
         for level in LEVELS:
             lo, hi = np.quantile(flat, [(1 - level) / 2, (1 + level) / 2], axis=0)
             inside[level].append((lo <= theta) & (theta <= hi))
+        # every replicate's data are compiled into its own programs: drop JAX's caches of them, or a long calibration
+        # runs out of memory mappings (the NUTS benchmark died at LLVM "Cannot allocate memory" within 100 replicates)
+        del posterior
+        jax.clear_caches()
         if progress:
             print(f"  SBC {engine} {r + 1}/{replicates} ({time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
     return Calibration(engine=sampler.label, names=names, truths=np.array(truths), ranks=np.array(ranks),

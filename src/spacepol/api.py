@@ -634,7 +634,7 @@ def design(data, model="paper", *, picks: int = 3, noise: dict | None = None, pr
     noise = dict(noise or {})
     for name, value in noise.items():
         if name not in DESIGN_NOISE or not (np.isfinite(float(value)) and float(value) > 0):
-            raise ParameterError(f"--noise '{name}={value}': expected dop=X, brdf=REL or mueller=X with X > 0")
+            raise ParameterError(f"--noise '{name}={value}': expected dop=X, brdf=REL or mueller=X with a finite X > 0")
     if picks < 1:
         raise ParameterError(f"--picks {picks}: need at least 1")
     data = load(data) if isinstance(data, (str, Path)) else data

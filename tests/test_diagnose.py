@@ -215,7 +215,7 @@ def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
     from spacepol.criticism.hidden_effects import suite
 
     case = next(c for c in suite() if c.effect == "polarized_diffuse")
-    candidates = ["polarized_diffuse", "extinction", "dop_bias"]
+    candidates = ["polarized_diffuse", "dop_bias"]
 
     def ranking(workers, seed=case.seed):
         from spacepol.criticism.diagnose import diagnose
@@ -223,7 +223,7 @@ def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
         from spacepol.physics import Model
 
         report = diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(seed), seed=0,
-                          candidates=candidates, top=2, progress=False, workers=workers)
+                          candidates=candidates, top=1, progress=False, workers=workers)
         return {e["change"]: (e["screening_gain"], e["delta_elpd"]) for e in report["ranking"]}, report["verdict"]
 
     one, verdict_one = ranking(1)

@@ -27,7 +27,7 @@ def ladder_table(public: list[dict]) -> list[str]:
     for i, r in enumerate(public):
         rmse = "n/a" if r["rmse_dop"] is None else f"{r['rmse_dop']:.4f}"
         cells = "".join(f" {r['inferred_noise'].get(n, float('nan')):.4g} |" for n in noise)
-        log_z = "n/a" if r.get("log_evidence") is None else f"{r['log_evidence']:.1f} +- {r['log_evidence_error']:.1f}"
+        log_z = "n/a" if r.get("log_evidence") is None else f"{r['log_evidence']:.1f} +- {r['log_evidence_error']:.2f}"
         lines.append(f"| {i} | {r['model']} | {rmse} | {r['chi2_red']:.3f} | {r['elpd_loo']:.1f} +- {r['elpd_loo_se']:.1f} |"
                      f" {log_z} |{cells} {_posterior_check(r)} |")
     flags = [f"rung {i}: {bound_finding(f)}" for i, r in enumerate(public) for f in r.get("at_bound", [])]

@@ -160,9 +160,10 @@ def configure_process(small_calls: bool = False) -> None:
 _CONFIGURED: list[bool] = []  # the calls of configure_process in this process
 
 
-def configured() -> bool:
-    """Whether this process called ``configure_process`` (worker processes it starts then call it too)."""
-    return bool(_CONFIGURED)
+def configured() -> bool | None:
+    """The ``small_calls`` of this process's last ``configure_process`` call, None where it made none (worker
+    processes it starts make the same call)."""
+    return _CONFIGURED[-1] if _CONFIGURED else None
 
 
 def ensure_double_precision() -> None:

@@ -71,20 +71,16 @@ def _leader(post, seed: int) -> tuple[float, np.ndarray]:
     return float(value), np.asarray(theta, float)
 
 
-def _refit(post, centre, seed: int, max_steps: int, posterior_method: str):
-    return fit_for_elpd(post, centre, seed, max_steps, posterior_method)
-
-
-TASKS = {"screen": _screen, "leader": _leader, "refit": _refit}
+TASKS = {"screen": _screen, "leader": _leader, "refit": fit_for_elpd}
 
 _WORKER: dict = {}  # in a worker process: the data and the fitting settings, sent once
 
 
-def _start_worker(data, observables, priors, configure: bool) -> None:
-    if configure:
+def _start_worker(data, observables, priors, small_calls: bool | None) -> None:
+    if small_calls is not None:  # the settings the calling process chose (None: it chose none)
         from .._runtime import configure_process
 
-        configure_process(small_calls=True)
+        configure_process(small_calls=small_calls)
     _WORKER.update(data=data, observables=observables, priors=priors)
 
 

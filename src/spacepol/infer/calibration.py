@@ -94,12 +94,13 @@ class Calibration:
 
     def to_json(self) -> dict:
         """The figures per parameter, the verdict and what failed."""
+        failures = self.failures()
+        c50, c90, p, counts = self.coverage(0.5), self.coverage(0.9), self.rank_p_values(), self.rank_histogram()
         return {"engine": self.engine, "replicates": self.replicates, "refused": self.refused,
                 "rank_draws": self.rank_draws, "likelihood_noise_scale": self.likelihood_noise_scale,
-                "seconds": self.seconds, "calibrated": self.calibrated, "failures": self.failures(),
-                "parameters": {name: {"coverage_50": float(self.coverage(0.5)[j]), "coverage_90": float(self.coverage(0.9)[j]),
-                                      "rank_p_value": float(self.rank_p_values()[j]),
-                                      "rank_histogram": self.rank_histogram()[:, j].tolist()}
+                "seconds": self.seconds, "calibrated": not failures, "failures": failures,
+                "parameters": {name: {"coverage_50": float(c50[j]), "coverage_90": float(c90[j]),
+                                      "rank_p_value": float(p[j]), "rank_histogram": counts[:, j].tolist()}
                                for j, name in enumerate(self.names)}}
 
     def figure(self, bins: int = 10):

@@ -115,7 +115,8 @@ def test_observables_declare_their_channels_and_noise():
 
 
 def _mueller_csv(path, data, header_extra=None, row_edit=None, errors="m_err"):
-    from spacepol.io.measurements import MUELLER_COLUMNS, write_table
+    from spacepol.io.measurements import write_table
+    from spacepol.observables.mueller import ELEMENTS as MUELLER_COLUMNS
 
     cols = {"theta_i": data.theta_i, "theta_r": data.theta_r, "dphi": data.dphi, "brdf": data.mueller[0, 0]}
     for m in MUELLER_COLUMNS:

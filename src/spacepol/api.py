@@ -99,22 +99,27 @@ def _dispersion(value) -> dict:
 
 
 def parse_observables(names) -> list[str] | None:
-    """``"dop,brdf"`` or ``["dop", "brdf"]`` checked against the observable registry; None keeps what the data hold."""
+    """``"dop,brdf"`` or ``["dop", "brdf"]`` checked against the observable registry (a user's observable as
+    ``path/to/file.py:Name``, registered here); None keeps what the data hold."""
     if names is None:
         return None
-    from .observables import ALIASES, OBSERVABLES
+    from .observables import registry
 
     text = names if isinstance(names, str) else ",".join(names)
     names = [o.strip() for o in text.split(",")]
     for name in names:
         if not name:
             raise ParameterError(f"--observables '{text}': an empty name (use e.g. dop,brdf)")
-        if name not in OBSERVABLES and name not in ALIASES:
-            raise ParameterError(f"--observables '{text}': unknown observable '{name}' (use {', '.join(OBSERVABLES)}; "
-                                 f"q, u name the Stokes pair)")
         if names.count(name) > 1:
             raise ParameterError(f"--observables '{text}': '{name}' named twice (each observable counts once)")
-    return names
+    chosen = []
+    for name in names:
+        try:
+            observable = registry.get(name)
+        except SpacepolError as exc:
+            raise ParameterError(f"--observables '{text}': {exc}") from None
+        chosen.append(observable.name if ".py:" in name else name)  # a file's observable by its registered name
+    return chosen
 
 
 def build_posterior(data: Dataset, model="paper", prior=None, observables=None, dispersion=None, robust: bool = False):
@@ -156,6 +161,7 @@ def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0
     options = {**({"walkers": walkers} if walkers is not None else {}),
                **({"max_steps": steps} if steps is not None else {}), **(engine_options or {})}
     sampler.check_options(options)
+    parse_observables(observables)  # registers a user's observable file before its columns are read
     data = load(data) if isinstance(data, (str, Path)) else data
     post = build_posterior(data, model, prior, observables, dispersion, robust)
     if walkers is not None:
@@ -616,14 +622,13 @@ class Design:
         return self.content
 
 
-DESIGN_NOISE = ("dop", "brdf", "mueller")
-
-
 def design(data, model="paper", *, picks: int = 3, noise: dict | None = None, prior=None, observables=None,
            seed: int = 0, out=None, progress: bool = False) -> Design:
     """The next measurements to make: at the posterior optimum of ``model`` on ``data``, the Fisher information of
-    every candidate geometry and observable; ``picks`` chosen greedily. ``noise``: {"dop": X, "brdf": REL,
-    "mueller": X} for the candidates (default: the data's own levels)."""
+    every candidate geometry and observable; ``picks`` chosen greedily. ``noise``: {observable: level} for the
+    candidates, e.g. {"dop": X, "brdf": REL, "mueller": X} (default: the data's own levels; the candidates are the
+    observables that declare a ``design_noise``)."""
+    from .criticism.design import candidate_observables
     from .criticism.design import design as rank_measurements
     from .infer.optimum import find_optimum
 
@@ -632,9 +637,11 @@ def design(data, model="paper", *, picks: int = 3, noise: dict | None = None, pr
 
         out = check_output_dir(out)
     noise = dict(noise or {})
+    candidates = candidate_observables()
     for name, value in noise.items():
-        if name not in DESIGN_NOISE or not (np.isfinite(float(value)) and float(value) > 0):
-            raise ParameterError(f"--noise '{name}={value}': expected dop=X, brdf=REL or mueller=X with a finite X > 0")
+        if name not in candidates or not (np.isfinite(float(value)) and float(value) > 0):
+            raise ParameterError(f"--noise '{name}={value}': expected OBSERVABLE=X with OBSERVABLE in "
+                                 f"{', '.join(candidates)} and a finite X > 0")
     if picks < 1:
         raise ParameterError(f"--picks {picks}: need at least 1")
     data = load(data) if isinstance(data, (str, Path)) else data

@@ -111,9 +111,11 @@ def demo(args) -> int:
 
 
 def load_dataset(args) -> Dataset:
-    """The data set of --data, --wavelength-um and --in-plane (``api.load``)."""
-    from .api import load
+    """The data set of --data, --wavelength-um and --in-plane (``api.load``); a user's observable named in
+    --observables (``path.py:Name``) is registered first, so that the file's columns for it are read."""
+    from .api import load, parse_observables
 
+    parse_observables(getattr(args, "observables", None))
     return load(args.data, args.wavelength_um, args.in_plane)
 
 

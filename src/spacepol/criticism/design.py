@@ -22,9 +22,16 @@ from .. import observables as obs
 from ..infer import fisher
 from ..physics.geometry import Geometry
 
-# assumed noise of a candidate measurement when the data do not tell it: DOP and m_ij absolute, BRDF relative
-DEFAULT_NOISE = {"dop": 0.01, "brdf": 0.05, "mueller": 0.01}
-CANDIDATE_OBSERVABLES = ("dop", "brdf", "mueller")
+
+
+def candidate_observables() -> list[str]:
+    """The observables a candidate measurement may be: those that declare a ``design_noise``."""
+    return [o.name for o in obs.every() if o.design_noise is not None]
+
+
+def default_noise() -> dict[str, float]:
+    """The noise assumed for a candidate measurement where the data do not tell it (relative for BRDF)."""
+    return {o.name: o.design_noise for o in obs.every() if o.design_noise is not None}
 
 
 @dataclass
@@ -37,8 +44,7 @@ class Candidate:
 
     def describe(self) -> str:
         """The candidate measurement in words (observable and angles)."""
-        what = {"dop": "DOP", "brdf": "BRDF", "mueller": "the Mueller matrix"}[self.observable]
-        return f"{what} at theta_i {self.theta_i:g}, theta_r {self.theta_r:g}, dphi {self.dphi:g} deg"
+        return f"{obs.get(self.observable).title} at theta_i {self.theta_i:g}, theta_r {self.theta_r:g}, dphi {self.dphi:g} deg"
 
 
 def candidate_geometry(angles=tuple(range(10, 81, 10)), azimuths=(180.0, 0.0, 90.0)) -> Geometry:
@@ -56,20 +62,20 @@ def _scale(likelihood, channel: str, point: dict) -> np.ndarray:
 
 def noise_levels(likelihood, point: dict) -> dict:
     """The noise of each observable as the data have it (median file error, or the inferred level at
-    ``point``), else DEFAULT_NOISE; BRDF as a relative level."""
-    out = dict(DEFAULT_NOISE)
+    ``point``), else the observable's ``design_noise``; a relative one (BRDF's) as a relative level."""
+    out = default_noise()
     for o in likelihood.objects:
         levels = []
         for ch in o.channels:
             scale = _scale(likelihood, ch, point)
-            if o.name == "brdf" and not likelihood.inferred(ch):  # absolute errors: as a relative level
+            if o.relative_noise and not likelihood.inferred(ch):  # absolute errors: as a relative level
                 scale = scale / np.maximum(np.abs(likelihood.observed()[ch]), 1e-300)
             levels.append(float(np.median(scale)))
         out[o.name] = float(np.median(levels))
     return out
 
 
-def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = None, observables=CANDIDATE_OBSERVABLES,
+def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = None, observables=None,
            noise: dict | None = None) -> dict:
     """Rank candidate measurements by how much they shrink the worst-measured parameter combination.
 
@@ -83,8 +89,7 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
     noise = {**noise_levels(lik, point), **(noise or {})}
     values = {k: v for k, v in point.items() if k in model_names}
     # the data in hand, each channel in its likelihood's residual space (BRDF in log when its noise is relative)
-    relative_brdf = "brdf" in lik.observables and lik.inferred("brdf")
-    channels, jac = fisher.jacobian(model, lik.geometry, lik.objects, values, names, relative_brdf=relative_brdf)
+    channels, jac = fisher.jacobian(model, lik.geometry, lik.objects, values, names, inferred=lik.inferred)
     info = fisher.information(jac, np.concatenate([_scale(lik, ch, point) for ch in channels]))
     prior = fisher.prior_precision(priors, names)
     prior_sd = 1.0 / np.sqrt(np.diag(prior))
@@ -108,9 +113,10 @@ def design(posterior, point: dict, picks: int = 3, geometry: Geometry | None = N
 
     grid = geometry if geometry is not None else candidate_geometry()
     blocks = {}  # observable -> (candidates, per-candidate information matrices)
-    for name in observables:
+    for name in observables or candidate_observables():
         o = obs.get(name)
-        cand_channels, cand_jac = fisher.jacobian(model, grid, [o], values, names)
+        # a candidate's noise is relative where the observable's is (log BRDF), else absolute
+        cand_channels, cand_jac = fisher.jacobian(model, grid, [o], values, names, inferred=lambda ch, o=o: o.relative_noise)
         n = grid.size
         per = []
         for j in range(n):
@@ -156,13 +162,13 @@ def _at_bound(prior, value, tolerance=1e-9) -> bool:
 def _words(involved, before, chosen, best_single, noise) -> str:
     what = ", ".join(involved)
     picks = "; then ".join(f"{c['measurement']} ({c['shrink']:.1f}x)" for c in chosen)
-    singles = ", ".join(f"{name.upper() if name != 'mueller' else 'Mueller'} at best {s['shrink']:.2f}x"
-                        for name, s in best_single.items())
+    singles = ", ".join(f"{obs.get(name).title} at best {s['shrink']:.2f}x" for name, s in best_single.items())
+    levels = ", ".join(f"{obs.get(name).title} {100 * level:.0f} %" if obs.get(name).relative_noise
+                       else f"{obs.get(name).title} {level:g}" for name, level in noise.items() if name in best_single)
     if before < 0.1:  # no degeneracy to break
         return (f"No degeneracy: the worst-measured combination (along {what}) already has a posterior sd of "
                 f"{before:.3f} of the prior's (Laplace approximation at the point). The best further measurements "
                 f"({picks}) would narrow it little; one measurement of each kind at its best geometry: {singles}.")
     return (f"The worst-measured combination is along {what}: its posterior sd is {before:.2f} of the prior's "
             f"(Laplace approximation at the point). To break it, measure {picks} (the factor is how much the sd "
-            f"along it shrinks, cumulative, at noise DOP {noise['dop']:g}, BRDF {100 * noise['brdf']:.0f} %, "
-            f"m_ij {noise['mueller']:g}). One measurement of each kind at its best geometry: {singles}.")
+            f"along it shrinks, cumulative, at noise {levels}). One measurement of each kind at its best geometry: {singles}.")

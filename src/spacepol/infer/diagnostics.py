@@ -92,18 +92,15 @@ def quantile_dict(values) -> dict:
 
 
 def _noise_names() -> tuple[str, ...]:
-    from ..observables import OBSERVABLES
+    from ..observables import every
 
-    names = [o.noise_parameter(ch).name for o in OBSERVABLES.values() for ch in o.channels]
+    names = [o.noise_parameter(ch).name for o in every() for ch in o.channels]
     return tuple(dict.fromkeys(names))
-
-
-NUISANCE_NOISE = _noise_names()
 
 
 def inferred_noise_levels(summary: dict) -> dict[str, float]:
     """{nuisance: posterior median} of the noise levels a run inferred (empty when the file gave errors)."""
-    return {n: summary["parameters"][n]["median"] for n in NUISANCE_NOISE if n in summary.get("parameters", {})}
+    return {n: summary["parameters"][n]["median"] for n in _noise_names() if n in summary.get("parameters", {})}
 
 
 def fit_words(chi2_red: float, noise: dict[str, float]) -> str:

@@ -17,12 +17,12 @@ from ..physics.compiled import Program
 from ..physics.geometry import Geometry
 from ..physics.model import Prediction
 
-_FLOOR = 1e-300
 
-
-def jacobian(model, geometry: Geometry, observables, point: dict, names: list[str], relative_brdf: bool = True):
+def jacobian(model, geometry: Geometry, observables, point: dict, names: list[str], inferred=lambda channel: True):
     """(channels, J): the predicted numbers' derivatives (n_numbers, len(names)) at ``point`` (every model
-    parameter's value), one block of geometry rows per channel in the order of ``channels``."""
+    parameter's value), one block of geometry rows per channel in the order of ``channels``, each in the space where
+    its noise is Gaussian (``Observable.noise_space``; ``inferred(channel)``: whether that noise is inferred, which
+    makes BRDF's relative)."""
     mueller = any(o.needs_mueller for o in observables)
     program = Program(model, geometry, mueller)
     fixed = {k: float(v) for k, v in point.items() if k not in names}
@@ -36,8 +36,7 @@ def jacobian(model, geometry: Geometry, observables, point: dict, names: list[st
         for o in observables:
             predicted = o.predict(prediction)
             for ch in o.channels:
-                mu = predicted[ch]
-                blocks.append(jnp.log(jnp.maximum(mu, _FLOOR)) if (ch == "brdf" and relative_brdf) else mu)
+                blocks.append(o.noise_space(ch, predicted[ch], inferred(ch)))
         return jnp.concatenate(blocks)
 
     theta0 = jnp.asarray([float(point[n]) for n in names])

@@ -109,10 +109,10 @@ def identifiability(posterior: Posterior, result: EngineResult) -> dict:
         for b in range(a + 1, len(names)):
             if abs(corr[a, b]) > STRONG_CORRELATION:
                 pairs.append((names[a], names[b], float(corr[a, b])))
-    observables = posterior.likelihood.observables
-    # effects declare the parameter that scales their lobe; DOP measures only ratios of them
-    scales = [e.intensity for e in posterior.likelihood.model.effects if e.intensity in names]
-    if len(scales) >= 2 and "brdf" not in observables:
+    lik = posterior.likelihood
+    # effects declare the parameter that scales their lobe; DOP, q, u and m_ij measure only ratios of them
+    scales = [e.intensity for e in lik.model.effects if e.intensity in names]
+    if len(scales) >= 2 and all(o.scale_free for o in lik.objects):
         findings.extend(_intensity_ratio_findings(flat, names, scales[0], scales[1]))
     for a, b, r in pairs:
         findings.append(f"{a} and {b} are strongly correlated (r = {r:+.2f}): the data fix a combination of them better than either.")

@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 
 from ..errors import SpacepolError
+from ..observables import registry
 from ..physics.model_spec import spec_of
 from .chain_file import chain_iterations, compact
 from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
@@ -152,6 +153,9 @@ def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: di
         "seed": seed,
         "observables": posterior.likelihood.observables,
         "observables_not_fitted": dict(posterior.likelihood.left_out),  # {name: the fitted observable holding it}
+        # a user's observable and the file it came from ("path.py:Name", "entry point X")
+        "observable_plugins": {o.name: registry.sources[o.name] for o in posterior.likelihood.objects
+                               if o.name in registry.sources},
         "n_observations": posterior.likelihood.n_obs,
         "priors": posterior.priors.describe(),
         "fixed": {k: float(v) for k, v in posterior.priors.fixed.items()},

@@ -60,10 +60,11 @@ def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]
     numbers}``: those named (aliases such as q, u allowed; nothing left out), or by default every observable
     in the data except those a fuller one contains (``observables.default_for``: the Mueller matrix holds
     q, u, DOP and AoP). Unknown, absent or repeated names are one-line errors."""
-    available = [o.name for o in obs.OBSERVABLES.values() if o.present(data)]
+    available = data.observables
     if not names:
         if not available:
-            raise ParameterError(f"{data.source}: no observable to fit (DOP, BRDF, Stokes, AoP or Mueller columns)")
+            raise ParameterError(f"{data.source}: no observable to fit (columns of any of "
+                                 f"{', '.join(obs.registry.names())})")
         chosen, left_out = obs.default_for(available)
         return [obs.get(n) for n in chosen], left_out
     names = list(names)

@@ -19,9 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..observables.mueller import index
-
-RECIPROCITY_SIGNS = np.array([1.0, 1.0, -1.0, 1.0])  # the diagonal of Q in M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q
+from ..observables.mueller import RECIPROCITY_SIGNS
 _MAD_TO_SIGMA = 1.482602218505602
 _MAD_RELATIVE_SE = 1.166  # sqrt(1 / (2 x 0.3675)): relative standard error of a MAD-based sigma, times sqrt(K)
 MIN_DIFFERENCES = 20  # fewer differences measure nothing worth a floor
@@ -120,16 +118,9 @@ def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict
             sources.setdefault("repeated geometries", []).append(np.asarray(owner.residual(channel, y[b], y[a], True), float))
         if not len(pairs_reciprocal):
             continue
-        if owner.name == "mueller":
-            i, j = index(channel)
-            mirror = observed[f"m{j + 1}{i + 1}"] if i != j else y
-            a, b = pairs_reciprocal.T
-            keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
-            sources.setdefault("reciprocal pairs", []).append(y[b[keep]] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * mirror[a[keep]])
-        elif owner.name == "brdf":
-            a, b = pairs_reciprocal[pairs_reciprocal[:, 0] != pairs_reciprocal[:, 1]].T
-            sources.setdefault("reciprocal pairs", []).append(
-                np.asarray(owner.residual(channel, y[b], y[a], likelihood.inferred(channel)), float))
+        d = owner.reciprocal_differences(channel, observed, pairs_reciprocal, likelihood.inferred(channel))
+        if d is not None:
+            sources.setdefault("reciprocal pairs", []).append(np.asarray(d, float))
     return out
 
 

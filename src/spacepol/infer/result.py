@@ -96,10 +96,11 @@ class Result:
     @property
     def spec(self) -> dict:
         """The whole model: effects, plug-in sources, wavelengths, dispersion (``physics.model_spec``), and the
-        observables fitted and the priors used."""
+        observables fitted (the channels; a user's observable with its source) and the priors used."""
         spec = self.summary.get("spec", self.summary["model"])
         spec = {"effects": spec, "plugins": {}, "wavelengths_um": None, "dispersion": {}} if isinstance(spec, str) else spec
         return {**spec, "observables": list(self.summary.get("observables", [])),
+                "observable_plugins": dict(self.summary.get("observable_plugins", {})),
                 "priors": dict(self.summary.get("priors", {})),
                 "fixed": dict(self.summary.get("fixed", {}))}
 

@@ -28,16 +28,3 @@ def is_blank_row(row: list[str], path, line) -> bool:
             raise InputFileError(path, "a row of empty fields (only separators): no values", line=line)
         return True
     return False
-
-
-def check_mueller_element(value, path, line, column):
-    """A normalised Mueller element M_ij / M_11 lies in [-1, 1]."""
-    if abs(value) > 1:
-        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
-
-
-def check_first_column(m21, m31, m41, path, line, column):
-    """The state unpolarized light leaves in (m21, m31, m41): its degree of polarization cannot exceed 1."""
-    dop = float(np.sqrt(m21**2 + m31**2 + m41**2))
-    if dop > 1:
-        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line, column=column)

@@ -1,81 +1,94 @@
-"""A data set of polarimetric measurements: the geometries and whatever observables a file holds."""
+"""A data set of polarimetric measurements: the geometries and the arrays of whatever observables a file holds.
+
+The Dataset knows no observable by name: it keeps the arrays each registered observable declares (``dop`` and
+``dop_err``, the (4, N) ``stokes``, the (4, 4, N) ``mueller`` ...), rows on the last axis, and selects and joins
+them generically. ``data.dop`` reads an array (None where absent); ``Dataset(..., dop=values)`` sets one.
+"""
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import InputFileError
+from ..observables import registry
 from ..physics.geometry import Geometry
 
 GEOMETRY_COLUMNS = ("theta_i", "theta_r", "dphi", "wavelength_um")
-MUELLER_COLUMNS = tuple(f"m{i}{j}" for i in range(1, 5) for j in range(1, 5))[1:]  # m12 ... m44 = M_ij / M_11
-OBSERVABLE_COLUMNS = (("dop", "dop_err", "brdf", "brdf_err", "s0", "s1", "s2", "s3", "aop", "aop_err")
-                      + MUELLER_COLUMNS + ("m_err",) + tuple(f"{m}_err" for m in MUELLER_COLUMNS))
-KNOWN_COLUMNS = GEOMETRY_COLUMNS + OBSERVABLE_COLUMNS
+_CORE = ("theta_i", "theta_r", "dphi", "wavelength_um", "metadata", "source", "arrays")
 
 
-@dataclass
 class Dataset:
-    """Measurements at N geometries.  Absent observables are ``None``; angles in degrees."""
+    """Measurements at N geometries: angles in degrees (``theta_i``, ``theta_r``, ``dphi``), ``wavelength_um``
+    per row (or None), and ``arrays``, {name: array with the rows on its last axis} for the observables present;
+    an array an observable declares but the data lack reads as None."""
 
-    theta_i: np.ndarray
-    theta_r: np.ndarray
-    dphi: np.ndarray
-    wavelength_um: np.ndarray | None = None
-    dop: np.ndarray | None = None
-    dop_err: np.ndarray | None = None
-    brdf: np.ndarray | None = None  # sr^-1
-    brdf_err: np.ndarray | None = None
-    stokes: np.ndarray | None = None  # (4, N): s0..s3 for unpolarized incidence (s3 may be 0)
-    aop: np.ndarray | None = None  # deg
-    aop_err: np.ndarray | None = None
-    mueller: np.ndarray | None = None  # (4, 4, N) BRDF Mueller matrix (sr^-1; M_11 = 1 when no BRDF was measured)
-    mueller_err: np.ndarray | None = None  # (4, 4, N) 1-sigma errors of the normalised elements m_ij (M_11's unused)
-    metadata: dict = field(default_factory=dict)
-    source: str = ""
+    def __init__(self, theta_i, theta_r, dphi, wavelength_um=None, metadata: dict | None = None, source: str = "",
+                 **arrays):
+        self.theta_i = np.asarray(theta_i)
+        self.theta_r = np.asarray(theta_r)
+        self.dphi = np.asarray(dphi)
+        self.wavelength_um = None if wavelength_um is None else np.asarray(wavelength_um)
+        self.metadata = dict(metadata or {})
+        self.source = source
+        self.arrays: dict[str, np.ndarray] = {}
+        for name, value in arrays.items():
+            self.set(name, value)
+
+    def set(self, name: str, value) -> None:
+        """Store the array ``name`` (one an observable declares; None removes it)."""
+        known = registry.array_names()
+        if name not in known:
+            raise TypeError(f"Dataset has no array '{name}' (the observables keep {', '.join(sorted(known))})")
+        if value is None:
+            self.arrays.pop(name, None)
+        else:
+            self.arrays[name] = np.asarray(value)
+
+    def get(self, name: str):
+        """The array ``name``, or None where the data lack it."""
+        return self.arrays.get(name)
+
+    def __getattr__(self, name):
+        # only reached for names that are not attributes: the observables' arrays (data.dop, data.mueller)
+        if name.startswith("_") or "arrays" not in self.__dict__:
+            raise AttributeError(name)
+        if name in registry.array_names():
+            return self.arrays.get(name)
+        raise AttributeError(f"'Dataset' object has no attribute '{name}'")
+
+    def __setattr__(self, name, value):
+        if name in _CORE or name.startswith("_"):
+            object.__setattr__(self, name, value)
+        else:
+            self.set(name, value)
 
     def __len__(self):
         return len(self.theta_i)
 
-    # Normalised Stokes parameters q = S1/S0, u = S2/S0 (s-polarized light has q > 0).
-    @property
-    def q(self):
-        """Normalised Stokes q = S1/S0 per row (None without Stokes columns)."""
-        return None if self.stokes is None else self.stokes[1] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
-
-    @property
-    def u(self):
-        """Normalised Stokes u = S2/S0 per row (None without Stokes columns)."""
-        return None if self.stokes is None else self.stokes[2] / np.where(self.stokes[0] > 0, self.stokes[0], np.inf)
-
-    q_err = None
-    u_err = None
+    def __repr__(self):
+        return f"Dataset({len(self)} rows, observables {', '.join(self.observables) or 'none'}, source {self.source!r})"
 
     @property
     def geometry(self) -> Geometry:
         """The rows' geometry (angles and wavelength), computed once."""
-        if not hasattr(self, "_geometry"):
+        if "_geometry" not in self.__dict__:
             self._geometry = Geometry(self.theta_i, self.theta_r, self.dphi, self.wavelength_um)
         return self._geometry
 
     @property
     def observables(self) -> list[str]:
-        """The observables the data hold: dop, brdf, aop, stokes, mueller."""
-        names = [n for n in ("dop", "brdf", "aop") if getattr(self, n) is not None]
-        if self.stokes is not None:
-            names.append("stokes")
-        if self.mueller is not None:
-            names.append("mueller")
-        return names
+        """The observables the data hold, in the registry's listing order."""
+        return [o.name for o in registry.every() if o.present(self)]
+
+    def _with_rows(self, take) -> "Dataset":
+        geometry = {name: take(getattr(self, name)) for name in GEOMETRY_COLUMNS if getattr(self, name) is not None}
+        arrays = {name: take(value) for name, value in self.arrays.items()}
+        return Dataset(**geometry, metadata=dict(self.metadata), source=self.source, **arrays)
 
     def select(self, mask) -> "Dataset":
         """A subset of the rows (boolean mask or indices)."""
         idx = np.arange(len(self))[mask]
-        changes = {name: None if (value := getattr(self, name)) is None else np.take(value, idx, axis=axis)
-                   for name, axis in _ROW_ARRAYS.items()}
-        return replace(self, **changes)
+        return self._with_rows(lambda value: np.take(value, idx, axis=-1))
 
     def in_plane(self, tolerance_deg: float = 1e-6) -> "Dataset":
         """Rows in the plane of incidence: dphi = 0 (retro side) or 180 deg (specular side)."""
@@ -111,17 +124,14 @@ class Dataset:
         observables and error columns; the metadata are the first part's, the source names every part."""
         if not parts:
             raise ValueError("Dataset.concatenate: no data sets given")
-        arrays = {}
-        for name, axis in _ROW_ARRAYS.items():
-            values = [getattr(p, name) for p in parts]
+        joined = {}
+        names = list(GEOMETRY_COLUMNS) + list(dict.fromkeys(a for p in parts for a in p.arrays))
+        for name in names:
+            values = [getattr(p, name) if name in GEOMETRY_COLUMNS else p.get(name) for p in parts]
             present = [v is not None for v in values]
             if any(present) and not all(present):
-                missing = ", ".join(p.source or f"part {i + 1}" for i, p in enumerate(parts) if getattr(p, name) is None)
+                missing = ", ".join(p.source or f"part {i + 1}" for i, p in enumerate(parts) if not present[i])
                 raise InputFileError(missing, f"has no '{name}' while the other data sets have it")
-            arrays[name] = np.concatenate(values, axis=axis) if all(present) else None
-        return cls(**arrays, metadata=dict(parts[0].metadata), source=" + ".join(p.source for p in parts))
-
-
-# every per-row array of a Dataset and the axis its rows lie on
-_ROW_ARRAYS = {"theta_i": 0, "theta_r": 0, "dphi": 0, "wavelength_um": 0, "dop": 0, "dop_err": 0, "brdf": 0,
-               "brdf_err": 0, "stokes": 1, "aop": 0, "aop_err": 0, "mueller": 2, "mueller_err": 2}
+            if all(present):
+                joined[name] = np.concatenate(values, axis=-1)
+        return cls(**joined, metadata=dict(parts[0].metadata), source=" + ".join(p.source for p in parts))

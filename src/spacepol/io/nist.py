@@ -16,7 +16,8 @@ import io as _io
 import numpy as np
 
 from ..errors import InputFileError
-from .cells import check_first_column, check_mueller_element, is_blank_row, parse_number
+from ..observables.mueller import check_element, check_first_column
+from .cells import is_blank_row, parse_number
 from .dataset import Dataset
 
 _RATIO_NAMES = [f"m{i}{j}" for i in range(1, 5) for j in range(1, 5)][1:]
@@ -55,7 +56,7 @@ def read_nist_rows(path, header, lines, header_line, meta):
         if values[5] < 0:
             raise InputFileError(path, f"negative BRDF {values[5]:g}", line=line, column=header[5])
         for i in range(6, 21):
-            check_mueller_element(values[i], path, line, header[i])
+            check_element(values[i], path, line, header[i])
         check_first_column(values[9], values[13], values[17], path, line, f"{header[9]}, {header[13]}, {header[17]}")
         rows.append(values)
     if not rows:

@@ -27,16 +27,17 @@ class AoP(ColumnObservable):
 
     name = "aop"
     scale_free = True
-    channels = ("aop",)
     label = "AoP (deg)"
+    title = "AoP"
+    listing_order = 30
     noise = Parameter("sigma_aop_deg", "deg", LogUniform(1e-2, 30.0), 1.0,
                       "AoP noise at DOP = 1, growing as 1 / DOP (inferred: the file has no aop_err)", physical=(1e-12, np.inf))
     min_dop = 0.05
 
     def noise_profile(self, channel, data):
-        dop = data.dop
-        if dop is None and data.stokes is not None:
-            s = data.stokes
+        dop = data.get("dop")
+        if dop is None and data.get("stokes") is not None:
+            s = data.get("stokes")
             dop = np.sqrt(s[1] ** 2 + s[2] ** 2 + s[3] ** 2) / np.where(s[0] > 0, s[0], np.inf)
         return None if dop is None else 1.0 / np.maximum(dop, self.min_dop)
 

@@ -5,8 +5,11 @@ the normalised Stokes parameters two, q and u, the normalised Mueller matrix fif
 It says from the model's output what each channel predicts, how a residual is formed, how the noise is
 modelled (the file's errors per row, or one inferred noise level for its channel group), its log
 density, how replicate data are drawn and its ArviZ dimensions. The likelihood, the residual analysis,
-the figures and the InferenceData use channels generically; adding an observable is one new file
-registered in ``observables/__init__.py``.
+the figures and the InferenceData use channels generically. It also says how it is read: the file columns it
+comes from (``columns``, ``optional_columns``, ``error_columns``), their checks, and the arrays the
+:class:`~spacepol.io.dataset.Dataset` keeps (``arrays``, rows on the last axis). Adding an observable is one new
+file in this package (found by the registry in ``observables/__init__.py``), an entry point of the group
+``spacepol.observables`` or a user's file (``--observables path/to/file.py:Name``).
 
 ``predict``, ``residual`` and ``log_density`` also run inside the compiled likelihood, on JAX arrays:
 they compute with ``array_module(...)`` (numpy for numpy arrays, jax.numpy for JAX ones).
@@ -19,6 +22,7 @@ import math
 import jax.numpy as jnp
 import numpy as np
 
+from ..errors import InputFileError
 from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
 
@@ -42,10 +46,52 @@ class Observable:
     # the Stokes vector, which gives DOP and AoP): by default only the fullest of them is fitted, so no
     # measured number is counted twice
     contains: tuple[str, ...] = ()
+    contained_in: tuple[str, ...] = ()  # the same relation declared by the contained one (a new observable's own file)
+    aliases: tuple[str, ...] = ()  # other names ``--observables`` takes for it (its channels, e.g. q and u)
+    title: str = ""  # in words, for sentences ("DOP", "the Mueller matrix")
+    listing_order: int = 100  # where it is listed among the observables (lists, summaries, figures)
+    # experiment design: the noise assumed for a candidate measurement where the data do not give one (None: this
+    # observable is not a candidate), relative (a fraction of the value, as BRDF's) or absolute
+    design_noise: float | None = None
+    relative_noise: bool = False
+
+    # reading a measurement file: the columns its values come from (all of them together), optional ones, the
+    # columns of their 1-sigma errors, and the Dataset arrays it keeps them in (rows on the last axis)
+    columns: tuple[str, ...] = ()
+    optional_columns: tuple[str, ...] = ()
+    error_columns: tuple[str, ...] = ()
+    arrays: tuple[str, ...] = ()
 
     def present(self, data) -> bool:
         """Whether the data set holds this observable."""
-        raise NotImplementedError
+        return data.get(self.arrays[0]) is not None
+
+    def in_header(self, header) -> bool:
+        """Whether a file's header holds this observable."""
+        return any(c in header for c in self.columns)
+
+    def check_header(self, header, path, line) -> None:
+        """All of ``columns`` or none; an error column only with the values it belongs to (one line otherwise)."""
+        given = [c for c in self.columns if c in header]
+        if given and len(given) < len(self.columns):
+            missing = ", ".join(c for c in self.columns if c not in header)
+            raise InputFileError(path, f"{self.title or self.name} data need all of {', '.join(self.columns)}; missing "
+                                       f"{missing}", line=line)
+        errors = [c for c in self.error_columns if c in header]
+        if errors and not given:
+            raise InputFileError(path, f"column '{errors[0]}' without '{self.columns[0]}'", line=line)
+
+    def check_value(self, column: str, value: float, path, line) -> None:
+        """One cell of one of its columns (a negative error here; subclasses add their ranges)."""
+        if column in self.error_columns and value < 0:
+            raise InputFileError(path, f"negative uncertainty {value:g}", line=line, column=column)
+
+    def check_row(self, values: dict, path, line) -> None:
+        """One row's cells together (a Stokes vector's length against s0): one line where they are impossible."""
+
+    def read(self, columns: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+        """The Dataset arrays from a file's columns (every column of the file, ``n`` rows)."""
+        return {c: columns[c] for c in self.columns + self.optional_columns + self.error_columns if c in columns}
 
     def observed(self, data) -> dict[str, np.ndarray]:
         """{channel: (N,) measured values}."""
@@ -59,9 +105,13 @@ class Observable:
         """{channel: (..., N) model values} from a ``physics.model.Prediction``."""
         raise NotImplementedError
 
+    def noise_space(self, channel: str, mu, inferred: bool):
+        """A prediction in the space where the noise is Gaussian (the value itself; log BRDF for a relative noise)."""
+        return mu
+
     def residual(self, channel: str, y, mu, inferred: bool):
         """Measured minus predicted, in the space where the noise is Gaussian."""
-        return y - mu
+        return self.noise_space(channel, y, inferred) - self.noise_space(channel, mu, inferred)
 
     def log_density(self, resid, scale):
         """Gaussian log density of the residuals at noise ``scale`` (same shape, broadcast)."""
@@ -78,6 +128,12 @@ class Observable:
         """Replicate data drawn like the measurement: prediction plus noise in the residual's space."""
         return mu + scale * rng.standard_normal(np.shape(mu))
 
+    def reciprocal_differences(self, channel: str, observed: dict, pairs: np.ndarray, inferred: bool):
+        """Differences of ``channel`` between reciprocal pairs (source and detector swapped; ``pairs`` (K, 2) row
+        indices, a row paired with itself where the geometry is its own reciprocal) that a passive sample makes pure
+        noise, in the residual's space; None where reciprocity says nothing about this observable."""
+        return None
+
     def noise_profile(self, channel: str, data) -> np.ndarray | None:
         """How an inferred noise level varies over the rows: (N,) factors on it, or None for a constant level."""
         return None
@@ -86,20 +142,29 @@ class Observable:
         """The nuisance parameter holding ``channel``'s noise level when the file gives no errors."""
         return self.noise
 
+    def axis_label(self, channel: str) -> str:
+        """A figure's axis label for one channel (the observable's ``label``; the channel's name among several)."""
+        return self.label if len(self.channels) == 1 else channel
+
     def dims(self, channel: str) -> list[str]:
         """ArviZ dimensions of one channel's array over the geometries."""
         return ["geometry"]
 
 
 class ColumnObservable(Observable):
-    """One channel read from the Dataset attribute of the same name, with its errors in ``NAME_err``."""
+    """One channel: the file column and Dataset array of its own name, its errors in ``NAME_err``."""
 
-    def present(self, data):
-        return getattr(data, self.name) is not None
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls.name and not cls.columns:
+            cls.columns, cls.error_columns = (cls.name,), (f"{cls.name}_err",)
+            cls.arrays = (cls.name, f"{cls.name}_err")
+        if cls.name and not cls.channels:
+            cls.channels = (cls.name,)
 
     def observed(self, data):
-        return {self.name: getattr(data, self.name)}
+        return {self.name: data.get(self.name)}
 
     def errors(self, data):
-        err = getattr(data, f"{self.name}_err")
+        err = data.get(f"{self.name}_err")
         return None if err is None else {self.name: err}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputFileError
 from ..priors import LogUniform
 from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
@@ -18,19 +19,32 @@ class BRDF(ColumnObservable):
     log BRDF)."""
 
     name = "brdf"
-    channels = ("brdf",)
     label = "BRDF (sr^-1)"
+    title = "BRDF"
+    listing_order = 20
+    design_noise = 0.05  # 5 %
+    relative_noise = True
     noise = Parameter("sigma_brdf_rel", "", LogUniform(1e-3, 2.0), 0.05,
                       "relative BRDF noise, sd of log BRDF (inferred: the file has no brdf_err)", physical=(1e-12, np.inf))
 
     def predict(self, prediction):
         return {"brdf": prediction.brdf}
 
-    def residual(self, channel, y, mu, inferred):
+    def check_value(self, column, value, path, line):
+        super().check_value(column, value, path, line)
+        if column == "brdf" and value < 0:
+            raise InputFileError(path, f"negative intensity {value:g}", line=line, column=column)
+
+    def noise_space(self, channel, mu, inferred):
         if inferred:
-            xp = array_module(y, mu)
-            return xp.log(xp.maximum(y, _FLOOR)) - xp.log(xp.maximum(mu, _FLOOR))
-        return y - mu
+            xp = array_module(mu)
+            return xp.log(xp.maximum(mu, _FLOOR))
+        return mu
+
+    def reciprocal_differences(self, channel, observed, pairs, inferred):
+        """The BRDF is the same with source and detector swapped (Helmholtz)."""
+        a, b = pairs[pairs[:, 0] != pairs[:, 1]].T
+        return self.residual(channel, observed[channel][b], observed[channel][a], inferred)
 
     def replicate(self, channel, mu, scale, inferred, rng):
         z = rng.standard_normal(np.shape(mu))

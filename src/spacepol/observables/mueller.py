@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputFileError
 from ..priors import LogUniform
 from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
@@ -24,11 +25,25 @@ _WORDS = {"pol": "polarizance and diattenuation elements m12 m13 m14 m21 m31 m41
 NOISE = {g: Parameter(f"sigma_m_{g}", "", LogUniform(1e-4, 0.5), 0.01, f"noise of the normalised Mueller {_WORDS[g]} (inferred)",
                       physical=(1e-12, np.inf)) for g in GROUPS}
 GROUP_OF = {e: g for g, members in GROUPS.items() for e in members}
+RECIPROCITY_SIGNS = np.array([1.0, 1.0, -1.0, 1.0])  # the diagonal of Q in M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q
 
 
 def index(element: str) -> tuple[int, int]:
     """Zero-based (row, column) of a Mueller element name ("m34" -> (2, 3))."""
     return int(element[1]) - 1, int(element[2]) - 1
+
+
+def check_element(value, path, line, column):
+    """A normalised Mueller element M_ij / M_11 lies in [-1, 1]."""
+    if abs(value) > 1:
+        raise InputFileError(path, f"normalised Mueller element {value:g} outside [-1, 1]", line=line, column=column)
+
+
+def check_first_column(m21, m31, m41, path, line, column):
+    """The state unpolarized light leaves in (m21, m31, m41): its degree of polarization cannot exceed 1."""
+    dop = float(np.sqrt(m21**2 + m31**2 + m41**2))
+    if dop > 1:
+        raise InputFileError(path, f"m21, m31, m41 imply DOP {dop:.4g} > 1 for unpolarized light", line=line, column=column)
 
 
 def normalised(mueller) -> dict[str, np.ndarray]:
@@ -46,21 +61,68 @@ class Mueller(Observable):
     scale_free = True
     channels = ELEMENTS
     label = "m_ij = M_ij / M_11"
+    title = "the Mueller matrix"
+    listing_order = 50
+    design_noise = 0.01
     needs_mueller = True
     contains = ("stokes", "dop", "aop")  # m21, m31, m41 are S1, S2, S3 / S0 for unpolarized incidence
+    columns = ELEMENTS
+    error_columns = ("m_err",) + tuple(f"{e}_err" for e in ELEMENTS)
+    arrays = ("mueller", "mueller_err")  # (4, 4, N): the BRDF Mueller matrix (M_11 = BRDF, or 1) and m_ij's errors
 
-    def present(self, data):
-        return data.mueller is not None
+    def check_header(self, header, path, line):
+        """All 15 normalised elements or none; errors as m_err, or per element for all 15 (m_err covering the rest)."""
+        given = [m for m in ELEMENTS if m in header]
+        if given and len(given) < 15:
+            missing = [m for m in ELEMENTS if m not in header]
+            raise InputFileError(path, f"Mueller data need all 15 elements m12 ... m44; missing {', '.join(missing)}", line=line)
+        errors = [f"{m}_err" for m in ELEMENTS if f"{m}_err" in header]
+        if (errors or "m_err" in header) and not given:
+            raise InputFileError(path, f"column '{(errors or ['m_err'])[0]}' without the Mueller elements m12 ... m44", line=line)
+        if errors and len(errors) < 15 and "m_err" not in header:
+            missing = [f"{m}_err" for m in ELEMENTS if f"{m}_err" not in header]
+            raise InputFileError(path, f"per-element Mueller errors need all 15 columns (or one m_err for the rest); "
+                                       f"missing {', '.join(missing)}", line=line)
+
+    def check_value(self, column, value, path, line):
+        super().check_value(column, value, path, line)
+        if column in ELEMENTS:
+            check_element(value, path, line, column)
+
+    def check_row(self, values, path, line):
+        check_first_column(values["m21"], values["m31"], values["m41"], path, line, "m21, m31, m41")
+
+    def read(self, columns, n):
+        """(4, 4, N) Mueller matrix (M_11 = the file's BRDF, or 1 without one) and its errors (None without any)."""
+        m11 = columns.get("brdf", np.ones(n))
+        mueller = np.empty((4, 4, n))
+        errors = np.full((4, 4, n), np.nan)
+        mueller[0, 0] = m11
+        for name in ELEMENTS:
+            mueller[index(name)] = m11 * columns[name]
+            err = columns.get(f"{name}_err", columns.get("m_err"))
+            if err is not None:
+                errors[index(name)] = err
+        has_errors = any(c in columns for c in self.error_columns)
+        return {"mueller": mueller, "mueller_err": errors if has_errors else None}
 
     def observed(self, data):
-        return normalised(data.mueller)
+        return normalised(data.get("mueller"))
 
     def errors(self, data):
-        err = getattr(data, "mueller_err", None)
+        err = data.get("mueller_err")
         return None if err is None else {e: err[index(e)] for e in ELEMENTS}
 
     def predict(self, prediction):
         return normalised(prediction.mueller)
+
+    def reciprocal_differences(self, channel, observed, pairs, inferred):
+        """m_ij(r -> i) - q_i q_j m_ji(i -> r): reciprocity transposes the matrix (Q = diag(1, 1, -1, 1))."""
+        i, j = index(channel)
+        mirror = observed[f"m{j + 1}{i + 1}"] if i != j else observed[channel]
+        a, b = pairs.T
+        keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
+        return observed[channel][b[keep]] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * mirror[a[keep]]
 
     def noise_parameter(self, channel):
         return NOISE[GROUP_OF[channel]]

@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..io.atomic import atomic_path, save_figure, write_json
+from ..observables import get as get_observable
 
 
 def shrink_map_figure(maps: dict, fig=None) -> Figure:
@@ -42,7 +43,7 @@ def design_lines(report: dict, source: str) -> list[str]:
     lines = [f"# Experiment design for {source}", "", *report["findings"], "",
              "| pick | measurement | noise | ridge sd after (prior units) | shrink |", "|---|---|---|---|---|"]
     for i, p in enumerate(report["picks"], 1):
-        noise = f"{100 * p['noise']:.0f} %" if p["observable"] == "brdf" else f"{p['noise']:g}"
+        noise = f"{100 * p['noise']:.0f} %" if get_observable(p["observable"]).relative_noise else f"{p['noise']:g}"
         lines.append(f"| {i} | {p['measurement']} | {noise} | {p['sd_after']:.3g} | {p['shrink']:.1f}x |")
     lines += ["", f"Ridge: {', '.join(report['ridge']['parameters'])}, direction "
               + ", ".join(f"{n} {c:+.2f}" for n, c in report["ridge"]["direction"].items() if abs(c) > 1e-3)

@@ -40,9 +40,6 @@ def signed_theta_r(data, idx=slice(None)):
     return np.where(forward, data.theta_r[idx], -data.theta_r[idx])
 
 
-_AXIS_LABEL = {"dop": "DOP", "brdf": "BRDF (sr^-1)", "q": "q = S1/S0", "u": "u = S2/S0"}
-
-
 def _in_plane(data, idx):
     return np.abs(np.sin(np.radians(data.dphi[idx]))) < 1e-6
 
@@ -85,13 +82,14 @@ def fit_figure(posterior, result, observables=None, max_draws: int = 2000, rng=N
                 ax.vlines(x[off], lo[idx][off], hi[idx][off], color="C1", lw=2, alpha=0.5, label="90 % band (out of plane)")
                 ax.plot(x[off], med[idx][off], "_", color="C1", ms=6)
             ax.errorbar(x, y[idx], yerr=None if err is None else err[idx], fmt="o", ms=2.5, color="k", lw=0.8, label="data")
-            if observable == "brdf" and np.all(y[idx] > 0):
+            owner = lik.observable_of(observable)
+            if owner.relative_noise and np.all(y[idx] > 0):  # a multiplicative noise: a log axis
                 ax.set_yscale("log")
             if row == 0:
                 ax.set_title(f"theta_i = {ti:g} deg", fontsize=9)
             if row == len(observables) - 1:
                 ax.set_xlabel("theta_r (deg; < 0: source side)", fontsize=8)
-            ax.set_ylabel(_AXIS_LABEL.get(observable, observable), fontsize=8)
+            ax.set_ylabel(owner.axis_label(observable), fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=6)

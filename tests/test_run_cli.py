@@ -81,6 +81,7 @@ def test_rerun_of_a_finished_run_reports_again_and_a_different_run_is_refused(ru
     assert clash.returncode == 2 and "holds the chain of a different run" in clash.stderr and "--restart" in clash.stderr
 
 
+@pytest.mark.slow
 def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     """Acceptance: NIST PTFE, 0.633 um, in-plane: R-hat <= 1.01, ESS >= 400, and the report
     says how the inferred n relates to PTFE's bulk index (about 1.35). By default the whole measured
@@ -106,6 +107,24 @@ def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     assert any(f["parameter"] == "rho_d" and f["side"] == "upper" for f in flags), flags
     assert "rho_d reaches its physical limit 1" in (out / "report.html").read_text()  # a reflectance of 1
     assert not any("well constrained" in f for f in s["identifiability"]["findings"])
+
+
+def test_ptfe_run_by_laplace_explains_the_index(tmp_path):
+    """The fast version of the test above (Laplace-IS instead of emcee: the same posterior, its own diagnostics):
+    the report says the model is wrong, the BRDF's residuals are structured, rho_d is at its physical limit."""
+    out = tmp_path / "ptfe"
+    run = cli("run", PTFE, "--wavelength-um", "0.633", "--in-plane", "--reference", "n=1.35", "--engine", "laplace",
+              "--quiet", "--out", out)
+    assert run.returncode == 0, run.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["diagnostics"]["pareto_k"] < 0.7 and s["diagnostics"]["ess_min"] >= 100
+    assert s["observables_not_fitted"] == {"dop": "mueller", "stokes": "mueller"}
+    ref = s["references"]["n"]
+    assert not ref["consistent"] and "model that is wrong" in ref["explanation"] and "1.35" in ref["explanation"]
+    assert s["residual_structure"]["runs"]["brdf"]["p"] < 0.01
+    flags = s["identifiability"]["at_bound"]
+    assert any(f["parameter"] == "rho_d" and f["side"] == "upper" for f in flags), flags
+    assert "rho_d reaches its physical limit 1" in (out / "report.html").read_text()
 
 
 def test_optimize_prints_json():

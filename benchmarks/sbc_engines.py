@@ -9,7 +9,8 @@ geometries (theta_i 25 and 55 deg, theta_r 5-75 deg), DOP with absolute noise 0.
 its own data set and run (``spacepol.infer.calibration.calibrate``); then the negative control, the same with the
 likelihood told the noise is 3x smaller than it is (a posterior 3x too narrow), which must fail. Prints per engine
 the coverage of the 50 % and 90 % intervals per parameter, the chi-square p of the rank histograms, refusals, time,
-and writes the rank histograms (``sbc_ENGINE.png``) and ``sbc.json`` to ``--out``.
+and writes the rank histograms (``sbc_ENGINE.png``) and ``sbc.json`` to ``--out`` (records of engines not run this
+time are kept).
 """
 
 import argparse
@@ -55,7 +56,8 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     load = os.getloadavg()
     print(f"load average before: {load[0]:.2f}", flush=True)
-    results = {}
+    # earlier runs' engines are kept: a run of one engine adds to (or replaces) its own records only
+    results = json.loads((out / "sbc.json").read_text()) if (out / "sbc.json").is_file() else {}
     for engine in args.engines:
         options = ENGINE_OPTIONS.get(engine, {})
         for label, scale, count in (("calibration", 1.0, args.replicates), ("control", 1 / 3, args.control_replicates)):

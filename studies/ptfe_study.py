@@ -323,17 +323,17 @@ def main(argv=None) -> int:
         result = diagnose_rounds(data, current, rng, 1, seed=args.seed, top=args.top, base=base)
         fits = as_rungs(result)
         if not rungs:
-            rungs.append(rung_record(result["rounds"][0], fits[0]["_inversion"], data))
-            observables = fits[0]["_inversion"].posterior.likelihood.observables
+            rungs.append(rung_record(result["rounds"][0], fits[0].inversion, data))
+            observables = fits[0].inversion.posterior.likelihood.observables
         if len(fits) == 1:  # nothing significant: the loop stops here
             rungs[-1]["equivalent"] = result["rounds"][0].get("equivalent", [])
             rungs[-1]["better"] = result["rounds"][0].get("better", [])
             done = True
         else:
-            rungs.append(rung_record(result["rounds"][1], fits[1]["_inversion"], data))
-            base = fits[1]["_inversion"]
+            rungs.append(rung_record(result["rounds"][1], fits[1].inversion, data))
+            base = fits[1].inversion
             current = base.posterior.likelihood.model
-        final = base or fits[0]["_inversion"]
+        final = base or fits[0].inversion
         save_figure(mueller_residual_figure(final.posterior, final.draws), out / "final_residuals_mueller.png")
         meta = {"data": "NIST sintered PTFE Mueller BRDF (Germer 2017)", "arguments": " ".join(argv or sys.argv[1:]),
                 "minutes": (time.perf_counter() - start) / 60, "machine": "2 cores", "rows": len(data),

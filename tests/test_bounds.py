@@ -53,7 +53,10 @@ def test_identifiability_never_calls_a_flagged_parameter_well_constrained():
     from spacepol.infer.identifiability import identifiability
 
     post = _posterior()
-    post.likelihood = SimpleNamespace(observables=["dop", "brdf"], model=Model.from_string("paper"))
+    from spacepol.observables import get
+
+    post.likelihood = SimpleNamespace(observables=["dop", "brdf"], objects=[get("dop"), get("brdf")],
+                                      model=Model.from_string("paper"))
     rng = np.random.default_rng(3)
     flat, names = _flat(post, n=post.priors.priors["n"].lower + np.abs(0.02 * rng.standard_normal(4000)))
     result = SimpleNamespace(flat_samples=lambda: flat, names=names)

@@ -111,7 +111,7 @@ def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per
     assert {"n@0.532", "n@1.064", "rho_l"} <= {p.name for p in changed.parameters}
     hidden = diagnose(render(changed, truth), base, np.random.default_rng(0), candidates=["lambertian", "oxide_layer"], top=1)
     assert hidden["verdict"] == "lambertian", hidden["ranking"][:2]
-    assert "n@1.064" in hidden["_base"].summary["parameters"]
+    assert "n@1.064" in hidden.base.summary["parameters"]
 
 
 @pytest.mark.slow  # 15 s; the null half of diagnose is in the default suite on one wavelength (test_diagnose)

@@ -25,14 +25,14 @@ def _path_effects(result) -> set:
 
 def _final_summary(result) -> dict:
     """The summary of the final model's inversion (the last round's accepted change, or the base)."""
-    reports = result["_reports"]
+    reports = result.reports
     last = result["rounds"][-1]
     if last["change"] is None:
-        return reports[0]["_base"].summary
+        return reports[0].base.summary
     for report in reversed(reports):
-        for c in report["_confirmed"]:
-            if c["change"] == last["change"] and c["inversion"].summary["model"] == last["model"]:
-                return c["inversion"].summary
+        for c in report.confirmed:
+            if c.label == last["change"] and c.inversion.summary["model"] == last["model"]:
+                return c.inversion.summary
     raise AssertionError("the final model's inversion is not among the rounds' refits")
 
 

@@ -545,22 +545,21 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
         content = diagnose_rounds(data, full_model, rng, rounds, seed=seed, observables=fitted, candidates=candidates,
                                   top=top, priors=overrides, posterior_method=posterior, workers=workers, criterion=criterion)
         rungs = as_rungs(content)
-        first = content.pop("_reports")[0]
-        base, confirmed = first["_base"], first["_confirmed"]
+        base, confirmed = content.reports[0].base, content.reports[0].confirmed
     else:
         content = run_diagnose(data, full_model, rng, seed=seed, observables=fitted, candidates=candidates, top=top,
                                priors=overrides, posterior_method=posterior, workers=workers, criterion=criterion)
-        base, confirmed = content.pop("_base"), content.pop("_confirmed")
+        base, confirmed = content.base, content.confirmed
         rungs = None
     if out is not None:
         from .report.diagnose_report import write_diagnose_report
 
-        write_diagnose_report(content, base, confirmed, Path(out), _data_label(data), path_rungs=rungs)
+        write_diagnose_report(content.to_json(), base, confirmed, Path(out), _data_label(data), path_rungs=rungs)
     if json_path is not None:
         from .io.atomic import write_json
 
-        write_json(json_path, content)
-    return Diagnosis(content, base, confirmed, rungs)
+        write_json(json_path, content.to_json())
+    return Diagnosis(content.to_json(), base, confirmed, rungs)
 
 
 @dataclass
@@ -568,11 +567,11 @@ class Ladder:
     """The rungs of a ladder: one per model, from the start through each change in order, with its fit (ELPD-LOO
     and its difference to the rung below, reduced chi^2, the noise it infers) and its Result."""
 
-    rungs: list[dict]
+    rungs: list
 
     def to_json(self) -> list[dict]:
         """The rungs as ``ladder.json`` holds them (without the Results)."""
-        return [{k: v for k, v in rung.items() if not k.startswith("_")} for rung in self.rungs]
+        return [rung.to_json() for rung in self.rungs]
 
 
 def ladder(data, model="paper", changes=(), *, observables=None, dispersion=None, seed: int = 0, out=None,

@@ -35,6 +35,7 @@ from ..physics.model import Model
 from ..physics.registry import registry
 from .candidate_fits import CandidateFits, _build, fit_for_elpd
 from .changes import changes, separating_measurement
+from .records import CandidateFit, DiagnosisRecord
 
 
 def _first_sentence(text: str) -> str:
@@ -51,7 +52,7 @@ def check_prior_names(data, model: Model, priors: dict, observables=None, candid
         raise SpacepolError(f"--prior: no parameter(s) {', '.join(unknown)} in {model.name} or any candidate effect")
 
 
-def _screen(posterior, rng, budget, seeds=None):
+def _global_optimum(posterior, rng, budget, seeds=None):
     value, theta = find_optimum(posterior, rng, evaluations=budget, seeds=seeds)
     return value, dict(zip(posterior.priors.names, theta))
 
@@ -69,7 +70,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
              priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
              posterior_method: str = "laplace", searched: dict | None = None, workers: int = 1,
-             fits: CandidateFits | None = None, criterion: str = "loo") -> dict:
+             fits: CandidateFits | None = None, criterion: str = "loo") -> DiagnosisRecord:
     """Rank the effects missing from ``model``; ``priors`` overrides default priors by parameter name;
     ``base``: a Result of ``model`` on these data already at hand (it is not refitted); ``confirm``:
     change labels refitted whatever their screening gain; ``simplifications``: how many changes with fewer free
@@ -88,15 +89,16 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         raise SpacepolError(f"--criterion {criterion}: unknown ({', '.join(CRITERIA)})")
     if fits is None:
         with CandidateFits(data, observables, priors, workers) as own:
-            return diagnose(data, model, rng, seed, observables, candidates, top, screening_evaluations, max_steps,
-                            progress, priors, base, confirm, simplifications, posterior_method, searched, fits=own,
-                            criterion=criterion)
+            return diagnose(data, model, rng, seed=seed, observables=observables, candidates=candidates, top=top,
+                            screening_evaluations=screening_evaluations, max_steps=max_steps, progress=progress,
+                            priors=priors, base=base, confirm=confirm, simplifications=simplifications,
+                            posterior_method=posterior_method, searched=searched, fits=own, criterion=criterion)
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     searched = {} if searched is None else searched
     base_post = _build(data, model, observables, priors)
     if model_key(model) not in searched:
-        searched[model_key(model)] = _screen(base_post, rng, screening_evaluations)
+        searched[model_key(model)] = _global_optimum(base_post, rng, screening_evaluations)
     base_best, base_optimum = searched[model_key(model)]
     all_candidates = changes(model, data, candidates)
     if base is None:
@@ -131,32 +133,31 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     screened = []
     for change, post in zip(all_candidates, posteriors):
         best, optimum = searched[model_key(change.model)]
-        screened.append({"effect": change.effect, "change": change.label, "_change": change, "model": change.model,
-                         "posterior": post, "screening_gain": float(best - base_best), "optimum": _vector(optimum, post)})
-    screened.sort(key=lambda c: -c["screening_gain"])
+        screened.append(CandidateFit(change, post, float(best - base_best), _vector(optimum, post)))
+    screened.sort(key=lambda c: -c.screening_gain)
 
     clock["screening"] = time.perf_counter()
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
-    to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c["screening_gain"], screened[0]["screening_gain"])]
+    to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c.screening_gain, screened[0].screening_gain)]
     # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits
-    twins = {t for c in to_confirm if c["_change"].kind == "add" for t in registry.get(c["effect"]).twins}
-    to_confirm += [c for c in screened if c not in to_confirm and c["_change"].kind == "add" and c["effect"] in twins]
-    to_confirm += [c for c in screened if c not in to_confirm and c["change"] in confirm]
+    twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins}
+    to_confirm += [c for c in screened if c not in to_confirm and c.kind == "add" and c.effect in twins]
+    to_confirm += [c for c in screened if c not in to_confirm and c.label in confirm]
     # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
     # significant, diagnose --rounds takes one that predicts as well (Occam)
-    simpler = [c for c in screened if c not in to_confirm and c["posterior"].ndim < base_post.ndim
-               and c["screening_gain"] > -2 * MIN_DELTA_ELPD]
+    simpler = [c for c in screened if c not in to_confirm and c.posterior.ndim < base_post.ndim
+               and c.screening_gain > -2 * MIN_DELTA_ELPD]
     to_confirm += simpler[:simplifications]
     # screening searched near the base model; a refit starts from the best of that and a global multistart
-    leaders = dict(fits.run("leader", [(c["model"], c["posterior"]) for c in to_confirm], rng))
+    leaders = dict(fits.run("leader", [(c.model, c.posterior) for c in to_confirm], rng))
     for i, c in enumerate(to_confirm):
         value, theta = leaders[i]
-        if value > c["screening_gain"] + base_best:
-            c.update(screening_gain=float(value - base_best), optimum=theta)
-            searched[model_key(c["model"])] = value, dict(zip(c["posterior"].priors.names, theta))
+        if value > c.screening_gain + base_best:
+            c.screening_gain, c.optimum = float(value - base_best), theta
+            searched[model_key(c.model)] = value, dict(zip(c.posterior.priors.names, theta))
     # changes refitted only because the caller asked (``confirm``: the slot alternatives diagnose --rounds weighs
     # at its end) and that their optima alone already show to differ significantly are not refitted
-    asked = [c for c in to_confirm if c["change"] in confirm]
+    asked = [c for c in to_confirm if c.label in confirm]
     if asked:
         best = np.array([base.draws.best[n] for n in base_post.priors.names], float)
         base_pointwise = base_post.log_prob_pointwise(best[None, :])[0]
@@ -164,10 +165,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     to_confirm = [c for c in to_confirm if c not in decided]
     clock["leaders"] = time.perf_counter()
     if progress and to_confirm:
-        _say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c['change'] for c in to_confirm)} "
+        _say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c.label for c in to_confirm)} "
              f"({time.perf_counter() - clock['start']:.0f} s)")
     # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
-    jobs = [(c["model"], c["posterior"], c["optimum"], seed, max_steps, posterior_method) for c in to_confirm]
+    jobs = [(c.model, c.posterior, c.optimum, seed, max_steps, posterior_method) for c in to_confirm]
     refits = {}
     for i, inv in fits.run("refit", jobs, rng):
         refits[i] = inv
@@ -175,81 +176,80 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             q = posterior_quality(inv)
             how = ("Laplace-IS" if q["engine"] == "laplace-is" else "emcee (the Laplace approximation was not trusted)"
                    + ("" if q["converged"] else f", which {_unconverged(q)}"))
-            _say(f"[confirm {len(refits)}/{len(to_confirm)}] {to_confirm[i]['change']}: {how}, "
+            _say(f"[confirm {len(refits)}/{len(to_confirm)}] {to_confirm[i].label}: {how}, "
                  f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
     confirmed = []
     for i, c in enumerate(to_confirm):
         inv = refits[i]
         diff = inv.loo["pointwise"] - base_loo
-        c.update(inversion=inv, pointwise=inv.loo["pointwise"], delta_elpd=float(diff.sum()),
-                 delta_elpd_se=float(np.sqrt(len(diff) * np.var(diff))),
-                 rmse_dop_after=inv.summary["fit"]["rmse_dop"], signatures=signatures(base, inv, base_fit))
-        c["significant"] = significant(c["delta_elpd"], c["delta_elpd_se"])
+        c.inversion, c.pointwise = inv, inv.loo["pointwise"]
+        c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
+        c.rmse_dop_after, c.signatures = inv.summary["fit"]["rmse_dop"], signatures(base, inv, base_fit)
+        c.significant = significant(c.delta_elpd, c.delta_elpd_se)
         confirmed.append(c)
     base_evidence = evidence_of(base, base_post, seed) if criterion == "evidence" else base.log_evidence
     for c in confirmed:
-        own = evidence_of(c["inversion"], c["posterior"], seed) if criterion == "evidence" else c["inversion"].log_evidence
+        own = evidence_of(c.inversion, c.posterior, seed) if criterion == "evidence" else c.inversion.log_evidence
         if own is not None and base_evidence is not None:
-            c["delta_log_evidence"] = own[0] - base_evidence[0]
-            c["delta_log_evidence_error"] = float(np.hypot(own[1], base_evidence[1]))
+            c.delta_log_evidence = own[0] - base_evidence[0]
+            c.delta_log_evidence_error = float(np.hypot(own[1], base_evidence[1]))
         if criterion == "evidence":
-            c["significant"] = significant_evidence(c["delta_log_evidence"], c["delta_log_evidence_error"])
+            c.significant = significant_evidence(c.delta_log_evidence, c.delta_log_evidence_error)
     if criterion == "evidence":
-        confirmed.sort(key=lambda c: -c["delta_log_evidence"])
+        confirmed.sort(key=lambda c: -c.delta_log_evidence)
     else:
-        confirmed.sort(key=lambda c: -c["delta_elpd"])
-    if confirmed and confirmed[0]["significant"]:
+        confirmed.sort(key=lambda c: -c.delta_elpd)
+    if confirmed and confirmed[0].significant:
         # changes that fit equally well (tied with the best): the one with fewer free parameters leads
-        group = [c for c in confirmed if c["significant"] and (c is confirmed[0] or _tied(confirmed[0], c))]
-        simplest = min(group, key=lambda c: (c["posterior"].ndim, -c["delta_elpd"]))
+        group = [c for c in confirmed if c.significant and (c is confirmed[0] or _tied(confirmed[0], c))]
+        simplest = min(group, key=lambda c: (c.posterior.ndim, -c.delta_elpd))
         confirmed.remove(simplest)
         confirmed.insert(0, simplest)
     clock["confirmation"] = time.perf_counter()
 
     ranking = []
     for i, c in enumerate(confirmed):
-        entry = {k: c[k] for k in ("effect", "change", "delta_elpd", "delta_elpd_se", "rmse_dop_after", "significant")}
-        entry["delta_log_evidence"] = c.get("delta_log_evidence")
-        entry["delta_log_evidence_error"] = c.get("delta_log_evidence_error")
-        entry["explains_misfit"] = not _structured(c["inversion"].summary)
-        entry["screening_gain"] = c["screening_gain"]
-        entry["explanation"] = _explain(c, base)
-        if c.get("delta_log_evidence") is not None:
-            entry["explanation"] += (f" ln Bayes factor over the model {c['delta_log_evidence']:+.1f} +- "
-                                     f"{c['delta_log_evidence_error']:.1f}"
+        entry = {"effect": c.effect, "change": c.label, "delta_elpd": c.delta_elpd, "delta_elpd_se": c.delta_elpd_se,
+                 "rmse_dop_after": c.rmse_dop_after, "significant": c.significant,
+                 "delta_log_evidence": c.delta_log_evidence, "delta_log_evidence_error": c.delta_log_evidence_error,
+                 "explains_misfit": not _structured(c.inversion.summary), "screening_gain": c.screening_gain,
+                 "explanation": _explain(c, base)}
+        if c.delta_log_evidence is not None:
+            entry["explanation"] += (f" ln Bayes factor over the model {c.delta_log_evidence:+.1f} +- "
+                                     f"{c.delta_log_evidence_error:.1f}"
                                      + (" (the criterion here)." if criterion == "evidence" else "."))
-        entry["posterior"] = posterior_quality(c["inversion"])
+        entry["posterior"] = posterior_quality(c.inversion)
         if not entry["posterior"]["converged"]:
             entry["explanation"] += (f" Its posterior {_unconverged(entry['posterior'])}: its delta ELPD-LOO is less "
                                      "certain than its SE says.")
         ranking.append(entry)
     for c in [c for c in screened if c not in to_confirm]:
-        entry = {"effect": c["effect"], "change": c["change"], "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-                 "significant": False, "screening_gain": c["screening_gain"],
-                 "explanation": f"Screened out: its best fit gains only {c['screening_gain']:.1f} in log posterior."}
-        if "plugin_delta" in c:
-            entry.update(plugin_delta=c["plugin_delta"], plugin_se=c["plugin_se"], explanation=(
-                f"Not refitted: at the two optima its log likelihood differs from the model's by {c['plugin_delta']:+.1f} "
-                f"+- {c['plugin_se']:.1f}, beyond 2 SE and any LOO correction ({c['plugin_margin']:.0f}); significantly "
-                f"{'better' if c['plugin_delta'] > 0 else 'worse'}."))
+        entry = {"effect": c.effect, "change": c.label, "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
+                 "significant": False, "screening_gain": c.screening_gain,
+                 "explanation": f"Screened out: its best fit gains only {c.screening_gain:.1f} in log posterior."}
+        if c.plugin_delta is not None:
+            entry.update(plugin_delta=c.plugin_delta, plugin_se=c.plugin_se, explanation=(
+                f"Not refitted: at the two optima its log likelihood differs from the model's by {c.plugin_delta:+.1f} "
+                f"+- {c.plugin_se:.1f}, beyond 2 SE and any LOO correction ({c.plugin_margin:.0f}); significantly "
+                f"{'better' if c.plugin_delta > 0 else 'worse'}."))
         ranking.append(entry)
     verdict = "none"
-    if confirmed and confirmed[0]["significant"]:
+    if confirmed and confirmed[0].significant:
         lead = confirmed[0]
-        verdict = lead["_change"].verdict
-        tied = [c for c in confirmed[1:] if c["significant"] and _tied(lead, c)]
+        verdict = lead.verdict
+        tied = [c for c in confirmed[1:] if c.significant and _tied(lead, c)]
         if tied:
-            ranking[0]["tied_with"] = [c["_change"].verdict for c in tied]
+            ranking[0]["tied_with"] = [c.verdict for c in tied]
             for other in tied:
                 sep = None
-                if lead["_change"].kind == other["_change"].kind == "add":
-                    sep = separating_measurement(lead["effect"], other["effect"])
+                if lead.kind == other.kind == "add":
+                    sep = separating_measurement(lead.effect, other.effect)
                 sep = sep or "a measurement in which they predict differently"
-                ranking[0]["explanation"] += (f" It fits these data as well as '{other['change']}' (equal within noise): the "
+                ranking[0]["explanation"] += (f" It fits these data as well as '{other.label}' (equal within noise): the "
                                               f"two are twins here; {sep} would separate them.")
     for entry, c in zip(ranking, confirmed):
-        entry["free_parameters"] = c["posterior"].ndim
-    return {"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
+        entry["free_parameters"] = c.posterior.ndim
+    return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
             "ranking": ranking, "verdict": verdict,
             "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
@@ -258,8 +258,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "confirmation": clock["confirmation"] - clock["screening"],
                         "leader_search": clock["leaders"] - clock["screening"],
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
-                        "candidates_refitted": len(confirmed)},
-            "_base": base, "_confirmed": confirmed}
+                        "candidates_refitted": len(confirmed)}},
+                           base, confirmed)
 
 
 def posterior_quality(inv) -> dict:
@@ -283,18 +283,18 @@ def _unconverged(quality: dict) -> str:
 PLUGIN_SE_SLACK = 1.25
 
 
-def _plugin_decides(c: dict, base_pointwise: np.ndarray, base_p_loo: float) -> bool:
+def _plugin_decides(c: CandidateFit, base_pointwise: np.ndarray, base_p_loo: float) -> bool:
     """Whether candidate ``c`` differs from the base so clearly that its refit cannot change the verdict: the pointwise
     log likelihood at its optimum minus the base's at the base's best draw (``base_pointwise``) sums to d with standard error s, and
     |d| - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = the base's p_loo + 2 x the candidate's free
     parameters (``base_p_loo``; ELPD-LOO = plug-in log likelihood - p_loo; the margin bounds the change in p_loo). On PTFE at 0.633 um
     (278 geometries, the eight slot alternatives of a five-effect model) the plug-in sums were within 17 of the
     refitted delta ELPD-LOO, whose p_loo changed by up to 26. Records the figures in ``c`` when it decides."""
-    d = c["posterior"].log_prob_pointwise(c["optimum"][None, :])[0] - base_pointwise
+    d = c.posterior.log_prob_pointwise(c.optimum[None, :])[0] - base_pointwise
     delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
-    margin = base_p_loo + 2.0 * c["posterior"].ndim
+    margin = base_p_loo + 2.0 * c.posterior.ndim
     if abs(delta) - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
-        c.update(plugin_delta=delta, plugin_se=se, plugin_margin=margin)
+        c.plugin_delta, c.plugin_se, c.plugin_margin = delta, se, margin
         return True
     return False
 
@@ -386,9 +386,9 @@ def _conclusion(base, confirmed, verdict) -> str:
                     "effect and rerun diagnose.")
         return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary['model']} "
                 "look like noise: nothing is missing at this noise level.")
-    lead = next(c for c in confirmed if c["_change"].verdict == verdict)
-    after = lead["inversion"].summary
-    text = f"{lead['change'][0].upper()}{lead['change'][1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
+    lead = next(c for c in confirmed if c.verdict == verdict)
+    after = lead.inversion.summary
+    text = f"{lead.label[0].upper()}{lead.label[1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
     if _structured(after):
         text += (f" It helps, but does not explain the misfit (partly explained): after it the residuals are still "
                  f"structured ({describe_fit(after)}; " + " ".join(after["residual_structure"]["findings"])
@@ -411,42 +411,42 @@ def _tied(a, b) -> bool:
     (A 1-SE rule without the signature split near-equals: on a rough dielectric render 'remove shadowing'
     +1202.5 and 'replace shadowing by smith' +1198.1 came out as a confident choice between them; a 2-SE
     rule alone tied 'remove shadowing' with 'add depolarization', which mend different misfits.)"""
-    diff = a["pointwise"] - b["pointwise"]
+    diff = a.pointwise - b.pointwise
     return (_signature_correlation(a, b) >= SAME_MISFIT
             and not significant(abs(float(diff.sum())), float(np.sqrt(len(diff) * np.var(diff)))))
 
 
 def _signature_correlation(a, b) -> float:
-    sa = np.concatenate([a["signatures"][o]["signature"] for o in sorted(a["signatures"])])
-    sb = np.concatenate([b["signatures"][o]["signature"] for o in sorted(b["signatures"])])
+    sa = np.concatenate([a.signatures[o]["signature"] for o in sorted(a.signatures)])
+    sb = np.concatenate([b.signatures[o]["signature"] for o in sorted(b.signatures)])
     if np.std(sa) == 0 or np.std(sb) == 0:
         return 1.0 if np.std(sa) == np.std(sb) else 0.0
     return float(np.corrcoef(sa, sb)[0, 1])
 
 
-def _explain(c, base) -> str:
-    cls = registry.get(c["effect"])
+def _explain(c: CandidateFit, base) -> str:
+    cls = registry.get(c.effect)
     physics = _first_sentence(cls.description)
-    if c["_change"].kind == "replace":
-        physics = f"Replace {c['_change'].replaced} by {c['effect']}: {physics}"
-    elif c["_change"].kind == "remove":
-        physics = f"Remove {c['effect']} ({physics[0].lower()}{physics[1:]})"
-    rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c["rmse_dop_after"]
+    if c.kind == "replace":
+        physics = f"Replace {c.change.replaced} by {c.effect}: {physics}"
+    elif c.kind == "remove":
+        physics = f"Remove {c.effect} ({physics[0].lower()}{physics[1:]})"
+    rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c.rmse_dop_after
     rmse = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
-    noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c["inversion"].summary)
+    noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c.inversion.summary)
     if noise0:
         rmse += "inferred noise " + ", ".join(f"{k} {noise0[k]:.3g} -> {noise1.get(k, float('nan')):.3g}" for k in noise0) + "; "
-    verdict = "significant" if c["significant"] else "not significant (gain within 2 SE or below 4)"
+    verdict = "significant" if c.significant else "not significant (gain within 2 SE or below 4)"
     why = []
     data = base.posterior.likelihood.data
-    for o, s in c["signatures"].items():
+    for o, s in c.signatures.items():
         change = (f"removes {100 * s['chi2_removed']:.0f} % of their chi^2" if s["chi2_removed"] >= 0
                   else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
                    f"correlates {s['correlation']:+.2f} with the residuals and {change}")
-    bounds = [bound_finding(f) for f in c["inversion"].summary["identifiability"].get("at_bound", [])]
-    if c["significant"] and _structured(c["inversion"].summary):
+    bounds = [bound_finding(f) for f in c.inversion.summary["identifiability"].get("at_bound", [])]
+    if c.significant and _structured(c.inversion.summary):
         bounds.insert(0, "it helps, but does not explain the misfit: after it the residuals are still structured ("
-                      + " ".join(c["inversion"].summary["residual_structure"]["findings"]) + ").")
-    return (f"{physics} Adding it changes ELPD-LOO by {c['delta_elpd']:+.1f} +- {c['delta_elpd_se']:.1f} ({verdict}); "
+                      + " ".join(c.inversion.summary["residual_structure"]["findings"]) + ").")
+    return (f"{physics} Adding it changes ELPD-LOO by {c.delta_elpd:+.1f} +- {c.delta_elpd_se:.1f} ({verdict}); "
             f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))

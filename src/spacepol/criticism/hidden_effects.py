@@ -161,9 +161,9 @@ def score(case: Case, report: dict) -> dict:
            "noise_dop": case.noise_dop, "size": case.size, "verdict": report["verdict"], "tied_with": lead.get("tied_with", []),
            "correct": (report["verdict"] == "none") if case.effect is None else (case.effect in named),
            "chi2_red_base": report["fit"]["chi2_red"]}
-    confirmed = {c["effect"]: c for c in report["_confirmed"] if c["_change"].kind == "add"}
+    confirmed = {c.effect: c for c in report.confirmed if c.kind == "add"}
     if case.effect in confirmed:
-        inversion = confirmed[case.effect]["inversion"]
+        inversion = confirmed[case.effect].inversion
         out["chi2_red_after"] = inversion.summary["fit"]["chi2_red"]
         out["covered"] = covered(case.effect, inversion, case.hidden)
     return out

@@ -13,10 +13,11 @@ from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from .changes import parse, start_points
+from .records import Rung
 
 
 def climb(data, model: Model, additions: list[str], seed: int = 0, observables=None, max_steps: int = 8000,
-          progress: bool = True, fitted: dict | None = None) -> list[dict]:
+          progress: bool = True, fitted: dict | None = None) -> list[Rung]:
     """One rung per change: ``additions`` are effect names or change labels ("replace shadowing by smith",
     "remove body"), applied in order.  ``fitted``: {model name: Result} already at hand on these data
     (e.g. from diagnose); reused."""
@@ -33,12 +34,12 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
             post = Posterior.build(data, current, observables=observables)
             centre = None
             if rungs:  # start from the previous rung's optimum, the change's new parameters at neutral values
-                seeds = start_points(rungs[-1]["_inversion"].summary["map"], change, post)
+                seeds = start_points(rungs[-1].inversion.summary["map"], change, post)
                 centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
             inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
         fit, noise = inv.summary["fit"], inferred_noise_levels(inv.summary)
         evidence = rung_evidence(inv, seed)
-        rungs.append({"model": current.name, "change": None if change is None else change.label,
+        rungs.append(Rung({"model": current.name, "change": None if change is None else change.label,
                       "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
                       "log_evidence": None if evidence is None else evidence[0],
@@ -47,8 +48,7 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                       "rhat_max": inv.summary["diagnostics"]["rhat_max"],
                       "pareto_k": inv.summary["diagnostics"].get("pareto_k"), "parameters": inv.summary["parameters"],
                       "at_bound": inv.summary["identifiability"].get("at_bound", []),
-                      "residual_structure": inv.summary["residual_structure"]["findings"],
-                      "_inversion": inv})
+                      "residual_structure": inv.summary["residual_structure"]["findings"]}, inv))
     return rungs
 
 

@@ -14,6 +14,7 @@ from ..physics.model import Model
 from .changes import changes, slot_alternatives
 from .candidate_fits import CandidateFits
 from .diagnose import _structured, diagnose, significant
+from .records import CandidateFit, DiagnosisRecord, RoundsRecord, Rung
 
 
 def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
@@ -24,28 +25,28 @@ def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives
             "structured": bool(_structured(summary)), "at_bound": summary["identifiability"].get("at_bound", [])}
 
 
-def as_rungs(result: dict) -> list[dict]:
+def as_rungs(result: RoundsRecord) -> list[Rung]:
     """The path as ladder rungs (for the ladder figure and table), with each round's Result."""
-    inversions = [result["_reports"][0]["_base"]]
-    for report, step in zip(result["_reports"], result["rounds"][1:]):
-        inversions.append(next(c["inversion"] for c in report["_confirmed"] if c["change"] == step["change"]))
+    inversions = [result.reports[0].base]
+    for report, step in zip(result.reports, result["rounds"][1:]):
+        inversions.append(next(c.inversion for c in report.confirmed if c.label == step["change"]))
     rungs = []
     for step, inv in zip(result["rounds"], inversions):
         fit = step["fit"]
-        rungs.append({"model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
+        rungs.append(Rung({"model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
                       "delta_elpd_se": step["delta_elpd_se"], "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"], "inferred_noise": step["inferred_noise"],
                       "noise": step.get("noise", {}), "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
                       "pareto_k": inv.summary["diagnostics"].get("pareto_k"),
-                      "at_bound": step["at_bound"], "_inversion": inv})
+                      "at_bound": step["at_bound"]}, inv))
     return rungs
 
 
 def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, seed: int = 0, observables=None,
                     candidates=None, top: int = 3, progress: bool = True, priors: dict | None = None, base=None,
-                    posterior_method: str = "laplace", workers: int = 1, criterion: str = "loo") -> dict:
+                    posterior_method: str = "laplace", workers: int = 1, criterion: str = "loo") -> RoundsRecord:
     """The first round's report (DESIGN's fields) plus ``rounds`` (the path), ``final_model`` and a
-    ``conclusion`` over the whole path; ``_reports`` keeps each round's full report. ``posterior_method``: how
+    ``conclusion`` over the whole path; the record's ``reports`` keep each round's DiagnosisRecord. ``posterior_method``: how
     each fit's posterior is drawn (``candidate_fits.fit_for_elpd``); ``workers``: candidates fitted at once, in
     worker processes started once for all rounds; ``criterion``: ``loo`` or ``evidence`` (``diagnose``)."""
     with CandidateFits(data, observables, priors, workers) as fits:
@@ -54,7 +55,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
 
 
 def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progress, priors, base, posterior_method,
-            fits, criterion="loo") -> dict:
+            fits, criterion="loo") -> RoundsRecord:
     reports, current = [], model
     path = []
     searched = {}  # the maxima found for each model screened so far (diagnose's ``searched``)
@@ -66,39 +67,38 @@ def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progre
                           searched=searched, fits=fits, criterion=criterion)
         reports.append(report)
         if not path:
-            path.append(_step(report["_base"].summary))
+            path.append(_step(report.base.summary))
         simplification = None
         if report["verdict"] == "none":
             simplification = _simplification(report)
             if simplification is None:
                 path[-1]["equivalent"], path[-1]["better"] = _slot_equivalents(
-                    data, current, rng, seed, observables, candidates, progress, priors, report["_base"], posterior_method,
+                    data, current, rng, seed, observables, candidates, progress, priors, report.base, posterior_method,
                     searched, fits)
                 break
-        lead = simplification or next(c for c in report["_confirmed"] if c["_change"].verdict == report["verdict"])
+        lead = simplification or next(c for c in report.confirmed if c.verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
         alternatives = [{k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se", "significant")}
-                        for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead["change"]]
-        path.append(_step(lead["inversion"].summary, lead["change"], lead["delta_elpd"], lead["delta_elpd_se"],
+                        for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead.label]
+        path.append(_step(lead.inversion.summary, lead.label, lead.delta_elpd, lead.delta_elpd_se,
                           [] if simplification else report["ranking"][0].get("tied_with", []), alternatives))
         path[-1]["simplification"] = simplification is not None
-        current, base = lead["_change"].model, lead["inversion"]
+        current, base = lead.model, lead.inversion
         if progress:
-            print(f"  round {r + 1}: {lead['change']} (delta ELPD {lead['delta_elpd']:+.1f} +- {lead['delta_elpd_se']:.1f}); "
-                  f"{describe_fit(lead['inversion'].summary)}", file=sys.stderr, flush=True)
-    first = {k: v for k, v in reports[0].items() if not k.startswith("_")}
-    out = {**first, "rounds": path, "final_model": current.name, "conclusion_rounds": _conclusion(path, reports)}
-    out["_reports"] = reports
-    return out
+            print(f"  round {r + 1}: {lead.label} (delta ELPD {lead.delta_elpd:+.1f} +- {lead.delta_elpd_se:.1f}); "
+                  f"{describe_fit(lead.inversion.summary)}", file=sys.stderr, flush=True)
+    content = {**reports[0].to_json(), "rounds": path, "final_model": current.name,
+               "conclusion_rounds": _conclusion(path, reports)}
+    return RoundsRecord(content, reports)
 
 
-def _simplification(report: dict):
+def _simplification(report: DiagnosisRecord) -> CandidateFit | None:
     """Where no change is significant: a refitted change with fewer free parameters that predicts as well
     (not significantly worse, the rule of ``significant``): the fewest parameters first, then the best ELPD."""
-    base_ndim = report["_base"].posterior.ndim
-    simpler = [c for c in report["_confirmed"] if c["posterior"].ndim < base_ndim
-               and not significant(-c["delta_elpd"], c["delta_elpd_se"])]
-    return min(simpler, key=lambda c: (c["posterior"].ndim, -c["delta_elpd"])) if simpler else None
+    base_ndim = report.base.posterior.ndim
+    simpler = [c for c in report.confirmed if c.posterior.ndim < base_ndim
+               and not significant(-c.delta_elpd, c.delta_elpd_se)]
+    return min(simpler, key=lambda c: (c.posterior.ndim, -c.delta_elpd)) if simpler else None
 
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
@@ -125,7 +125,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     return _equivalent(report, labels), _better(report, labels)
 
 
-def _equivalent(report: dict, labels) -> list[dict]:
+def _equivalent(report: DiagnosisRecord, labels) -> list[dict]:
     """Slot alternatives whose refit is not significantly better or worse than the final model: the data
     cannot tell which member fills that slot."""
     out = []
@@ -135,7 +135,7 @@ def _equivalent(report: dict, labels) -> list[dict]:
     return out
 
 
-def _better(report: dict, labels) -> list[dict]:
+def _better(report: DiagnosisRecord, labels) -> list[dict]:
     """Slot alternatives significantly better than the final model: refitted (delta ELPD-LOO > 2 SE and > 4) or
     decided by their optima alone (``diagnose._plugin_decides``: the plug-in difference and its SE, flagged)."""
     out = []
@@ -150,7 +150,7 @@ def _better(report: dict, labels) -> list[dict]:
     return sorted(out, key=lambda e: -e["delta_elpd"])
 
 
-def _conclusion(path: list[dict], reports: list[dict]) -> str:
+def _conclusion(path: list[dict], reports: list[DiagnosisRecord]) -> str:
     final = path[-1]
     changes = [p["change"] + (" (simpler, predicts as well)" if p.get("simplification") else "") for p in path[1:]]
     route = " -> ".join([path[0]["model"]] + changes) if changes else path[0]["model"]

@@ -99,7 +99,7 @@ def score(case: SwapCase, result: dict) -> dict:
     for a null case), and the final fit."""
     path = [r["change"] for r in result["rounds"][1:]]
     final = result["rounds"][-1]
-    tied = {t for report in result["_reports"] for entry in report["ranking"][:1] for t in entry.get("tied_with", [])}
+    tied = {t for report in result.reports for entry in report["ranking"][:1] for t in entry.get("tied_with", [])}
     additions = [c for c in path if c.startswith("add ") and c not in DIFFUSE_CHANGES]
     if case.effect is None:  # no addition of an effect the surface does not have (smith refilling its slot is fine)
         effect_ok = not [a for a in additions if a.split()[1] not in case.spec.split("+")]

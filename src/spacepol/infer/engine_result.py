@@ -6,6 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+RHAT_TARGET = 1.01  # a sampler waits for ArviZ's rank-normalised split R-hat at most this
+ESS_TARGET = 400.0  # and bulk and tail ESS at least this
+
 
 @dataclass
 class EngineResult:

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import SpacepolError
 from .engine_result import EngineResult
-from .engines.emcee_sampler import ESS_TARGET, RHAT_TARGET
+from .engine_result import ESS_TARGET, RHAT_TARGET
 
 SUMMARY_FILE = "summary.json"
 POSTERIOR_FILE = "posterior.nc"

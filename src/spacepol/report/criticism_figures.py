@@ -50,7 +50,7 @@ def ladder_figure(rungs, fig=None) -> Figure:
     grid = fig.add_gridspec(2, len(rungs))
     scatter = None
     for i, rung in enumerate(rungs):
-        inv = rung["_inversion"]
+        inv = rung.inversion
         ax = fig.add_subplot(grid[0, i])
         obs = inv.posterior.likelihood.observables[0]
         z = standardised_residuals(inv.posterior, inv.draws.flat_samples())[obs]

@@ -79,14 +79,14 @@ def forward_comparison(data, out: Path) -> list[str]:
     return lines
 
 
-def criticise(data, base, out: Path, label: str, seed: int, max_additions: int = 2) -> tuple[dict, list[dict]]:
+def criticise(data, base, out: Path, label: str, seed: int, max_additions: int = 2) -> tuple:
     """diagnose (reusing the base fit), then a ladder adding the verdict and the next significant,
     non-twin effects; writes ``out/diagnose/`` and ``out/ladder/``."""
     model = base.posterior.likelihood.model
     report = diagnose(data, model, np.random.default_rng(seed), seed=seed, base=base)
-    base, confirmed = report.pop("_base"), report.pop("_confirmed")
-    write_diagnose_report(report, base, confirmed, out / "diagnose", label)
-    write_json(out / "diagnose.json", report)
+    base, confirmed = report.base, report.confirmed
+    write_diagnose_report(report.to_json(), base, confirmed, out / "diagnose", label)
+    write_json(out / "diagnose.json", report.to_json())
     additions, current = [], model
     if report["verdict"] != "none":
         twins = set(report["ranking"][0].get("tied_with", []))
@@ -99,14 +99,14 @@ def criticise(data, base, out: Path, label: str, seed: int, max_additions: int =
             except SpacepolError:
                 continue
             additions.append(r["change"])
-    fitted = {base.summary["model"]: base} | {c["inversion"].summary["model"]: c["inversion"] for c in confirmed}
+    fitted = {base.summary["model"]: base} | {c.inversion.summary["model"]: c.inversion for c in confirmed}
     rungs = climb(data, model, additions, seed=seed, fitted=fitted)
     write_ladder_report(rungs, out / "ladder")
     return report, rungs
 
 
 def _criticism_section(report, rungs, folder: str) -> str:
-    public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rungs]
+    public = [r.to_json() for r in rungs]
     noise = list(dict.fromkeys(k for r in public for k in r.get("inferred_noise", {})))
     if noise:  # inferred noise: chi^2 ~ 1 by construction; the inferred level is the error that falls
         head = ["model", "RMSE(DOP)", "ELPD-LOO"] + [f"inferred {n}" for n in noise]

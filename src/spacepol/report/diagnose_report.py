@@ -61,8 +61,8 @@ def significance_statement(report: dict) -> str:
     return text + "."
 
 
-def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, data_label: str,
-                          path_rungs: list[dict] | None = None) -> dict[str, Path]:
+def write_diagnose_report(report: dict, base, confirmed: list, out: Path, data_label: str,
+                          path_rungs: list | None = None) -> dict[str, Path]:
     """Write the figures and report.html into ``out``; returns the figure paths. ``path_rungs``: the
     rounds of `diagnose --rounds` as ladder rungs (a path section, ``path.png`` and ``path.md``)."""
     out = Path(out)
@@ -72,9 +72,10 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     paths["trends"] = out / "residual_trends_base.png"
     save_figure(residual_trends_figure(analyse(base.posterior, base.draws.flat_samples())), paths["trends"])
     for c in confirmed:
-        paths[c["change"]] = out / figure_name(c["change"])
-        save_figure(residual_figure(c["inversion"].posterior, c["inversion"].draws), paths[c["change"]])
-    save_figure(signature_figure(base, [(_name(c), c["signatures"]) for c in confirmed]), paths["signatures"])
+        paths[c.label] = out / figure_name(c.label)
+        save_figure(residual_figure(c.inversion.posterior, c.inversion.draws), paths[c.label])
+    labels = [_name({"change": c.label, "effect": c.effect}) for c in confirmed]
+    save_figure(signature_figure(base, [(label, c.signatures) for label, c in zip(labels, confirmed)]), paths["signatures"])
     fit = report["fit"]
     sections = [
         ("Data and base model", H.paragraph(
@@ -95,7 +96,7 @@ def write_diagnose_report(report: dict, base, confirmed: list[dict], out: Path, 
     if path_rungs:
         paths["path"] = out / "path.png"
         save_figure(ladder_figure(path_rungs), paths["path"])
-        public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in path_rungs]
+        public = [r.to_json() for r in path_rungs]
         table = ladder_table(public)
         with atomic_path(out / "path.md") as tmp:
             tmp.write_text("\n".join(table) + "\n", encoding="utf-8")

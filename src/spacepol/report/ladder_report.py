@@ -50,7 +50,7 @@ def write_ladder_report(rungs: list[dict], out: Path, json_path=None) -> list[st
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     save_figure(ladder_figure(rungs), out / "ladder.png")
-    public = [{k: v for k, v in r.items() if not k.startswith("_")} for r in rungs]
+    public = [r.to_json() for r in rungs]
     write_json(json_path or out / "ladder.json", {"rungs": public})
     lines = ladder_table(public)
     with atomic_path(out / "ladder.md") as tmp:

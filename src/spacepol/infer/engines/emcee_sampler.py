@@ -37,7 +37,7 @@ import emcee
 import numpy as np
 
 from ..buffered_backend import BufferedHDFBackend
-from ..engine_result import EngineResult
+from ..engine_result import ESS_TARGET, RHAT_TARGET, EngineResult
 from ..sampling_space import SamplingSpace, reaching_a_bound
 from .snooker import DESnookerMove
 
@@ -105,8 +105,6 @@ def _rhat_ess(sampler, tau, space):
     return worst_rhat_ess(chain.transpose(1, 0, 2))
 
 
-RHAT_TARGET = 1.01  # a run waits for ArviZ's rank-normalised split R-hat at most this
-ESS_TARGET = 400.0  # and bulk and tail ESS at least this
 
 
 def starting_points(posterior, rng, count: int, initial=None):

@@ -26,7 +26,7 @@ import numpy as np
 from ..differentiable import log_likelihood_function
 from ..engine_result import EngineResult
 from ..sampling_space import SamplingSpace
-from .emcee_sampler import ESS_TARGET, RHAT_TARGET
+from ..engine_result import ESS_TARGET, RHAT_TARGET
 
 
 def _potential(posterior, space):

@@ -48,7 +48,7 @@ def data(tmp_path_factory):
     return path
 
 
-RUN = ("--model", "specular+smith", "--steps", "1500", "--seed", "2")
+RUN = ("--model", "specular+smith", "--steps", "900", "--seed", "2")
 
 
 def test_kill_during_sampling_and_during_the_report_then_the_same_command_completes(data, tmp_path):
@@ -67,9 +67,9 @@ def test_kill_during_sampling_and_during_the_report_then_the_same_command_comple
 
     again = cli("run", data, *RUN, "--out", out)
     assert again.returncode == 0, again.stderr
-    assert "is complete (1500 steps" in again.stderr
+    assert "is complete (900 steps" in again.stderr
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["sampler"]["steps"] == 1500
+    assert summary["sampler"]["steps"] == 900
     assert not list(out.glob(".*.tmp")), "a half-written file was left behind"
 
     finished = cli("run", data, *RUN, "--out", out)  # a finished run re-run: reports again, exit 0
@@ -80,25 +80,25 @@ def test_kill_during_sampling_and_during_the_report_then_the_same_command_comple
 
 def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path):
     out = tmp_path / "run"
-    first = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    first = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
     assert first.returncode == 0, first.stderr
     chain = out / "chain.h5"
     size = chain.stat().st_size
     with open(chain, "r+b") as fh:  # a kill during a write / a full disk: the file is cut short
         fh.truncate(size // 3)
-    damaged = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    damaged = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
     assert damaged.returncode == 2
     lines = damaged.stderr.strip().splitlines()
     assert len(lines) == 1 and "damaged chain file" in lines[0] and "--restart" in lines[0], damaged.stderr
     assert "Traceback" not in damaged.stderr
 
-    restarted = cli("run", data, *RUN, "--steps", "500", "--quiet", "--restart", "--out", out)
+    restarted = cli("run", data, *RUN, "--steps", "300", "--quiet", "--restart", "--out", out)
     assert restarted.returncode == 0, restarted.stderr
     assert (out / "chain.h5.old").stat().st_size == size // 3  # the old file kept aside
-    assert json.loads((out / "summary.json").read_text())["sampler"]["steps"] == 500
+    assert json.loads((out / "summary.json").read_text())["sampler"]["steps"] == 300
 
     chain.write_bytes(b"")  # an empty file
-    empty = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    empty = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
     assert empty.returncode == 2 and "empty file" in empty.stderr
 
 
@@ -111,19 +111,19 @@ def test_a_chain_whose_random_state_a_kill_broke_continues(data, tmp_path):
     import numpy as np
 
     out = tmp_path / "run"
-    first = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    first = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
     assert first.returncode == 0, first.stderr
     chain = out / "chain.h5"
     with h5py.File(chain, "a") as f:  # what a reader sees after the kill: no readable random state
         for key in [k for k in f["mcmc"].attrs if k.startswith("random_state")]:
             del f["mcmc"].attrs[key]
-        before = f["mcmc"]["chain"][:500].copy()
-    more = cli("run", data, *RUN, "--steps", "1000", "--out", out)
+        before = f["mcmc"]["chain"][:300].copy()
+    more = cli("run", data, *RUN, "--steps", "600", "--out", out)
     assert more.returncode == 0, more.stderr
     assert "resuming the chain" in more.stderr and "Traceback" not in more.stderr
     with h5py.File(chain, "r") as f:
-        assert f["mcmc"].attrs["iteration"] == 1000
-        np.testing.assert_array_equal(f["mcmc"]["chain"][:500], before)
+        assert f["mcmc"].attrs["iteration"] == 600
+        np.testing.assert_array_equal(f["mcmc"]["chain"][:300], before)
 
 
 def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
@@ -155,5 +155,5 @@ def test_a_failed_run_leaves_nothing_that_blocks_the_corrected_command(data, tmp
     out = tmp_path / "run"
     bad = cli("run", data, *RUN, "--walkers", "3", "--out", out)
     assert bad.returncode == 2 and not out.exists()
-    good = cli("run", data, *RUN, "--steps", "500", "--quiet", "--out", out)
+    good = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
     assert good.returncode == 0, good.stderr

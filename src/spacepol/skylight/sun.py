@@ -64,20 +64,32 @@ def sun_position(lat_deg: float, lon_deg: float, time: str | datetime, height_m:
         raise ParameterError(f"--lat {lat_deg}: latitude must be within [-90, 90] deg")
     if not -180.0 <= lon_deg <= 360.0:
         raise ParameterError(f"--lon {lon_deg}: longitude must be within [-180, 360] deg")
+    utc = parse_time(time) if isinstance(time, str) else time.astimezone(timezone.utc)
+    zenith, azimuth, _ = sun_track(lat_deg, lon_deg, [utc], height_m)
+    return SunPosition(float(zenith[0]), float(azimuth[0]), utc.isoformat())
+
+
+def sun_track(lat_deg: float, lon_deg: float, times_utc, height_m: float = 0.0):
+    """The sun over many times (aware datetimes) at one site: (zenith_deg (N,), azimuth_deg (N,) east of north, unit
+    vectors towards the sun (3, N) in the geocentric celestial frame GCRS); no refraction; offline, any date."""
     import astropy.units as u
+    import numpy as np
     from astropy.coordinates import AltAz, EarthLocation, get_sun
     from astropy.time import Time
     from astropy.utils import iers
 
-    utc = parse_time(time) if isinstance(time, str) else time.astimezone(timezone.utc)
+    utc = [t.astimezone(timezone.utc).replace(tzinfo=None) for t in times_utc]
     site = EarthLocation(lat=lat_deg * u.deg, lon=lon_deg * u.deg, height=height_m * u.m)
     # offline, any date: bundled tables, never an age limit, extrapolate (with a warning) past their end
     with iers.conf.set_temp("auto_download", False), iers.conf.set_temp("auto_max_age", None), \
             iers.conf.set_temp("iers_degraded_accuracy", "warn"), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        when = Time(utc.replace(tzinfo=None), scale="utc")
-        altaz = get_sun(when).transform_to(AltAz(obstime=when, location=site))  # pressure 0: no refraction
+        when = Time(utc, scale="utc")
+        sun = get_sun(when)
+        altaz = sun.transform_to(AltAz(obstime=when, location=site))  # pressure 0: no refraction
     if any(("IERS" in str(w.message) or "leap" in str(w.message).lower() or "dubious" in str(w.message).lower())
            for w in caught):
-        _note_once("iers", _DEGRADED_NOTE.format(when=utc.date().isoformat()))
-    return SunPosition(float(90.0 - altaz.alt.deg), float(altaz.az.deg % 360.0), utc.isoformat())
+        _note_once("iers", _DEGRADED_NOTE.format(when=utc[0].date().isoformat()))
+    xyz = np.atleast_2d(sun.cartesian.xyz.to(u.km).value.T).T
+    return (np.atleast_1d(90.0 - altaz.alt.deg), np.atleast_1d(altaz.az.deg % 360.0),
+            xyz / np.linalg.norm(xyz, axis=0))

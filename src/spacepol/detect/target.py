@@ -1,0 +1,115 @@
+"""The target's light at the aperture over a pass: the sunlit faces of a satellite, each with its area, orientation
+and a material (a run's posterior draws or fixed parameters), give the Stokes flux of the reflected sunlight.
+
+For unpolarized sunlight of band irradiance E on a face of area A at incidence theta_i, seen at reflection angle
+theta_r from range R, the Stokes flux at the aperture is
+
+    F = E cos(theta_i) A cos(theta_r) / R^2 x S(theta_i, theta_r, dphi)     (W m^-2, and photons m^-2 s^-1)
+
+with S the first column of the material's Mueller BRDF (sr^-1; ``Prediction.stokes``). Each face's S is in its own
+basis (s = n x d normalised, d the direction to the observer: DESIGN.md's convention); the faces' Stokes vectors
+are rotated into one basis before they are summed: s_ref = u x d normalised, with u the site's geocentric vertical,
+so S1 > 0 is light polarized horizontally on the observer's sky and the AoP is measured from the horizontal
+towards the vertical. A face that is not lit (theta_i >= 90 deg, or the satellite in Earth's shadow) or not seen
+(theta_r >= 90 deg, or below the horizon) adds nothing; other faces' shadows and light reflected between faces are
+left out.
+
+The sun in the band: a 5772 K black body (IAU 2015 nominal solar effective temperature) of the sun's radius (695,700
+km) at 1 au. Across 1.0-2.0 um this is within a few per cent of measured solar spectra (e.g. ASTM E-490); the
+scenario may override the band irradiance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..physics.geometry import Geometry
+
+SUN_TEMPERATURE_K = 5772.0
+SUN_RADIUS_KM = 695_700.0
+AU_KM = 149_597_870.7
+_H, _C, _K = 6.62607015e-34, 299_792_458.0, 1.380649e-23
+
+
+def solar_band(band_low_um: float, band_high_um: float, temperature_k: float = SUN_TEMPERATURE_K) -> tuple[float, float]:
+    """(irradiance W m^-2, photon flux photons m^-2 s^-1) of the sun at 1 au in the band (a black body)."""
+    if not 0 < band_low_um < band_high_um:
+        raise ParameterError(f"band {band_low_um:g}-{band_high_um:g} um: need 0 < low < high")
+    lam = np.linspace(band_low_um, band_high_um, 2001) * 1e-6  # m
+    radiance = 2 * _H * _C**2 / lam**5 / np.expm1(_H * _C / (lam * _K * temperature_k))  # W m^-2 sr^-1 m^-1
+    dilution = np.pi * (SUN_RADIUS_KM / AU_KM) ** 2  # the sun's solid angle x its Lambertian pi
+    irradiance = dilution * np.trapezoid(radiance, lam)
+    photons = dilution * np.trapezoid(radiance * lam / (_H * _C), lam)
+    return float(irradiance), float(photons)
+
+
+@dataclass
+class TargetLight:
+    """The target's light at the aperture over a pass, for D material draws at T times: ``stokes_w_m2`` (4, D, T) in
+    the sky basis (S1 > 0 horizontal), ``photons_m2_s`` (D, T) (S0 in photons), ``dolp`` and ``aop_deg`` (D, T;
+    NaN where no light comes), ``lit_faces`` (T,) how many faces send light."""
+
+    stokes_w_m2: np.ndarray
+    photons_m2_s: np.ndarray
+    dolp: np.ndarray
+    aop_deg: np.ndarray
+    lit_faces: np.ndarray
+
+    def band(self, quantity: str) -> dict:
+        """{"median", "q05", "q95"} over the draws at each time (lists of length T) of ``photons_m2_s``, ``dolp`` or
+        ``aop_deg``."""
+        values = getattr(self, quantity)
+        with np.errstate(all="ignore"):
+            q = np.nanpercentile(values, [5, 50, 95], axis=0) if np.isfinite(values).any() else np.full((3, values.shape[1]), np.nan)
+        return {"median": q[1].tolist(), "q05": q[0].tolist(), "q95": q[2].tolist()}
+
+
+def _rotation_to_sky(normals: np.ndarray, to_observer: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """The angle (rad) that turns a face's s vector (n x d) into the sky's (u x d) about d, per time (3, T) inputs."""
+    s_face = np.cross(normals.T, to_observer.T).T
+    s_sky = np.cross(up.T, to_observer.T).T
+    s_face /= np.maximum(np.linalg.norm(s_face, axis=0), 1e-300)
+    s_sky /= np.maximum(np.linalg.norm(s_sky, axis=0), 1e-300)
+    return np.arctan2(np.sum(np.cross(s_face.T, s_sky.T).T * to_observer, axis=0), np.sum(s_face * s_sky, axis=0))
+
+
+def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irradiance_w_m2: float | None = None) -> TargetLight:
+    """The light of the target (``geometry``: a ``orbit.PassGeometry`` with faces) for the material ``model`` at the
+    parameter draws ``draws`` ({name: (D,) or scalar}; the rest at the model's defaults) in the band ``band_um``.
+    ``irradiance_w_m2`` overrides the black-body sun's band irradiance (the photon flux scales with it)."""
+    if not geometry.faces:
+        raise ParameterError("target: no faces (give each its area, orientation and normal)")
+    irradiance, photons = solar_band(*band_um)
+    if irradiance_w_m2 is not None:
+        photons *= irradiance_w_m2 / irradiance
+        irradiance = irradiance_w_m2
+    names = {p.name for p in model.parameters}
+    params = {k: np.atleast_1d(np.asarray(v, float)) for k, v in draws.items() if k in names}
+    n_draws = max((len(v) for v in params.values()), default=1)
+    n_times = len(geometry.times_utc)
+    up = (geometry.position_km + geometry.range_km * geometry.to_observer_unit)
+    up /= np.linalg.norm(up, axis=0)
+    stokes = np.zeros((4, n_draws, n_times))
+    lit_faces = np.zeros(n_times, int)
+    for k, face in enumerate(geometry.faces):
+        on = geometry.lit[:, k] & geometry.seen[:, k]
+        if not on.any():
+            continue
+        lit_faces += on
+        rows = np.flatnonzero(on)
+        g = Geometry(geometry.theta_i_deg[rows, k], geometry.theta_r_deg[rows, k], geometry.dphi_deg[rows, k])
+        s = np.asarray(model.evaluate(params, g).stokes, float).reshape(4, -1, len(rows))  # (4, D or 1, rows) sr^-1
+        ti, tr = np.radians(geometry.theta_i_deg[rows, k]), np.radians(geometry.theta_r_deg[rows, k])
+        scale = irradiance * np.cos(ti) * face.area_m2 * np.cos(tr) / (geometry.range_km[rows] * 1e3) ** 2
+        psi = _rotation_to_sky(geometry.normals(k)[:, rows], geometry.to_observer_unit[:, rows], up[:, rows])
+        c, sn = np.cos(2 * psi), np.sin(2 * psi)
+        rotated = np.stack([s[0], c * s[1] + sn * s[2], -sn * s[1] + c * s[2], s[3]])
+        stokes[:, :, rows] += rotated * scale
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit = stokes[0] > 0
+        dolp = np.where(lit, np.hypot(stokes[1], stokes[2]) / np.where(lit, stokes[0], 1.0), np.nan)
+        aop = np.where(lit, 0.5 * np.degrees(np.arctan2(stokes[2], stokes[1])), np.nan)
+    return TargetLight(stokes, stokes[0] * photons / irradiance, dolp, aop, lit_faces)

@@ -1,0 +1,8 @@
+"""A satellite's pass over a site: its TLE read and propagated with SGP4 (skyfield), the direction and range from the
+site, the sun, whether the satellite is sunlit and the sky is in daylight, the phase angle, and each face's
+incidence, reflection and azimuth angles in its own frame."""
+
+from .pass_geometry import Face, PassGeometry, pass_geometry
+from .tle import TLE, read_tle
+
+__all__ = ["Face", "PassGeometry", "TLE", "pass_geometry", "read_tle"]

@@ -1,0 +1,82 @@
+"""The target's light over a pass (issue 26, item 2): a faceted Lambertian sphere against Lambert's analytic sphere,
+the polarization of specular reflection perpendicular to the sun - target - observer plane on the sky, and the
+sun's band irradiance against the solar constant."""
+
+import numpy as np
+import pytest
+
+from spacepol.detect.target import solar_band, target_light
+from spacepol.orbit import Face, pass_geometry, read_tle
+from spacepol.paths import bundled
+from spacepol.physics.model import Model
+
+SITE = (43 + 8 / 60, 125 + 32 / 60, 200.0)
+START, END = "2014-01-21T00:33:30Z", "2014-01-21T00:39:00Z"
+BAND = (1.5, 1.8)
+
+
+@pytest.fixture(scope="module")
+def tle():
+    return read_tle(bundled("tle", "iss_zarya_2014-01-20.tle"))
+
+
+def sphere_faces(radius_m: float, n: int) -> list[Face]:
+    """A sphere as ``n`` inertial faces of equal area (a Fibonacci lattice of normals)."""
+    k = np.arange(n) + 0.5
+    z = 1 - 2 * k / n
+    phi = np.pi * (1 + 5**0.5) * k
+    r = np.sqrt(1 - z**2)
+    area = 4 * np.pi * radius_m**2 / n
+    return [Face(f"f{i}", area, "inertial", (r[i] * np.cos(phi[i]), r[i] * np.sin(phi[i]), z[i])) for i in range(n)]
+
+
+def test_the_sun_in_a_wide_band_gives_the_solar_constant():
+    """The black body over 0.1-100 um holds all but 0.1 % of sigma T^4 (R/au)^2 = 1361 W m^-2 (the measured solar
+    constant is 1361 W m^-2, Kopp & Lean 2011); 1.5-1.8 um holds about 5 % of it."""
+    total, _ = solar_band(0.1, 100.0)
+    assert total == pytest.approx(1361.0, rel=0.01)
+    band, photons = solar_band(*BAND)
+    assert 0.03 < band / total < 0.08
+    assert photons == pytest.approx(band / (6.62607015e-34 * 299792458.0 / 1.65e-6), rel=0.02)  # ~ E / (hc / lambda_mid)
+
+
+def test_a_faceted_lambertian_sphere_matches_lamberts_sphere(tle):
+    """Flux of a Lambertian sphere of radius a, albedo rho: F = (2/3) rho E a^2 / (pi R^2) [sin a + (pi - a) cos a]
+    at phase angle a. 4,000 faces reach it within 0.5 %; the control: a sphere of half the faces' albedo is 50 % off."""
+    rho, radius = 0.6, 2.0
+    g = pass_geometry(tle, SITE, START, END, step_s=30.0, faces=sphere_faces(radius, 4000))
+    light = target_light(g, Model.from_string("lambertian"), {"rho_l": rho}, BAND)
+    irradiance, _ = solar_band(*BAND)
+    a = np.radians(g.phase_angle_deg)
+    expected = 2 / 3 * rho * irradiance * radius**2 / (np.pi * (g.range_km * 1e3) ** 2) * (np.sin(a) + (np.pi - a) * np.cos(a))
+    seen = g.visible
+    ratio = light.stokes_w_m2[0, 0, seen] / expected[seen]
+    assert np.abs(ratio - 1).max() < 0.005, ratio
+    assert np.allclose(light.dolp[0, seen], 0.0, atol=1e-9)  # Lambertian light is unpolarized
+    half = target_light(g, Model.from_string("lambertian"), {"rho_l": rho / 2}, BAND)
+    assert np.abs(half.stokes_w_m2[0, 0, seen] / expected[seen] - 1).min() > 0.4
+
+
+def test_specular_light_is_polarized_perpendicular_to_the_scattering_plane_on_the_sky(tle):
+    """Unpolarized sunlight reflected by facets leaves polarized along k_in x k_out, perpendicular to the plane of
+    sun, target and observer, whatever each face's own basis: the AoP of the summed faces on the sky (from the
+    horizontal, towards the vertical) is that direction's, and the DoLP is between 0 and 1 and not 0."""
+    faces = sphere_faces(1.0, 800)
+    g = pass_geometry(tle, SITE, START, END, step_s=30.0, faces=faces)
+    draws = {"n": np.array([1.5, 1.7]), "k": np.array([0.0, 0.1]), "sigma": np.array([0.2, 0.3]), "ks": np.array([1.0, 1.0])}
+    light = target_light(g, Model.from_string("specular+smith"), draws, BAND)
+    seen = g.visible
+    d = g.to_observer_unit
+    up = g.position_km + g.range_km * d
+    up /= np.linalg.norm(up, axis=0)
+    s_ref = np.cross(up.T, d.T).T
+    s_ref /= np.linalg.norm(s_ref, axis=0)
+    p_ref = np.cross(d.T, s_ref.T).T
+    e = np.cross(g.sun_unit.T, d.T).T  # the normal of the scattering plane
+    expected = np.degrees(np.arctan2(np.sum(e * p_ref, axis=0), np.sum(e * s_ref, axis=0)))
+    for j in range(2):
+        diff = (light.aop_deg[j, seen] - expected[seen] + 90.0) % 180.0 - 90.0
+        assert np.abs(diff).max() < 0.5, diff
+        assert np.all((light.dolp[j, seen] > 0.01) & (light.dolp[j, seen] < 1.0))
+    # the control: the AoP 90 deg off (polarization in the scattering plane) is far from it
+    assert np.abs((light.aop_deg[0, seen] - (expected[seen] + 90.0) + 90.0) % 180.0 - 90.0).min() > 45.0

@@ -1,0 +1,88 @@
+"""Detecting a point source in micro-polarizer frames at a fixed false-alarm rate.
+
+The target adds s_c(x) electrons to channel c (the analysers at 0, 45, 90, 135 deg) of the pixels x around its known
+position (its photon flux through the PSF and each analyser's transmission); the sky adds b_c electrons per pixel,
+the same everywhere in the stamp and known from the frames around it. With Gaussian noise of variance v_c = b_c +
+dark + read^2 per pixel (Poisson in the high-count regime) the likelihood-ratio test is a matched filter, and the
+Neyman-Pearson curve is P_d = Q(Q^-1(P_fa) - d) with d the deflection (the SNR of the filter's output):
+
+- ``intensity``: one filter on the channels' sum (what an intensity camera sees): d^2 = (sum s)^2 / sum v;
+- ``stokes``: the filter on every channel with its own noise (the four analysers jointly, i.e. the Stokes images):
+  d^2 = sum_c sum_x s_c(x)^2 / v_c. It gains where the sky is polarized (one analyser sees less of it) and the
+  target's polarization differs from the sky's;
+- ``dolp``: the degree of linear polarization of the background-subtracted flux at the target, whose threshold comes
+  from sky-only frames (no closed form): ``empirical_threshold`` and ``detection_probability`` measure it.
+
+``threshold_from_sky`` sets any detector's threshold from statistics on sky-only frames.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import stats
+
+DETECTORS = ("intensity", "stokes", "dolp")
+
+
+def gaussian_psf(size: int, fwhm_pixels: float, centre: tuple[float, float] | None = None) -> np.ndarray:
+    """(size, size) PSF normalised to sum 1: a circular Gaussian of the FWHM given, centred on the stamp."""
+    sigma = fwhm_pixels / (2 * np.sqrt(2 * np.log(2)))
+    cy, cx = centre if centre is not None else ((size - 1) / 2, (size - 1) / 2)
+    y, x = np.mgrid[0:size, 0:size]
+    psf = np.exp(-((x - cx) ** 2 + (y - cy) ** 2) / (2 * sigma**2))
+    return psf / psf.sum()
+
+
+def neyman_pearson(deflection, p_false_alarm: float):
+    """P_d = Q(Q^-1(P_fa) - d) of a matched filter with deflection d in Gaussian noise."""
+    return stats.norm.sf(stats.norm.isf(p_false_alarm) - np.asarray(deflection, float))
+
+
+def deflections(signal: np.ndarray, variance: np.ndarray) -> dict[str, float]:
+    """{detector: d} of the intensity and Stokes matched filters for the target's electrons ``signal`` (4, H, W) per
+    analyser channel and the noise ``variance`` (4,) or (4, H, W) per channel pixel."""
+    signal = np.asarray(signal, float)
+    variance = np.broadcast_to(np.asarray(variance, float).reshape(4, *([1] * (signal.ndim - 1))), signal.shape)
+    total = signal.sum(axis=0)
+    return {"intensity": float(np.sum(total**2 / variance.sum(axis=0)) ** 0.5),
+            "stokes": float(np.sum(signal**2 / variance) ** 0.5)}
+
+
+def matched_filter(frames: np.ndarray, background: np.ndarray, signal: np.ndarray, variance: np.ndarray,
+                   detector: str) -> np.ndarray:
+    """The whitened matched-filter statistic of each frame (N, 4, H, W) for the known ``signal`` (4, H, W) over the
+    known ``background`` (4,) per channel pixel; normalised to unit variance, so the mean with the target is d."""
+    frames = np.asarray(frames, float) - np.asarray(background, float).reshape(1, 4, 1, 1)
+    var = np.broadcast_to(np.asarray(variance, float).reshape(4, *([1] * (signal.ndim - 1))), signal.shape)
+    if detector == "intensity":
+        summed, s, v = frames.sum(axis=1), signal.sum(axis=0), var.sum(axis=0)
+        return np.tensordot(summed, s / v, axes=([1, 2], [0, 1])) / np.sqrt(np.sum(s**2 / v))
+    if detector == "stokes":
+        return np.tensordot(frames, signal / var, axes=([1, 2, 3], [0, 1, 2])) / np.sqrt(np.sum(signal**2 / var))
+    raise ValueError(f"detector '{detector}': the matched filters are intensity and stokes")
+
+
+def dolp_statistic(frames: np.ndarray, background: np.ndarray, psf: np.ndarray) -> np.ndarray:
+    """The DoLP of the PSF-weighted, background-subtracted flux of each frame (N, 4, H, W): a polarization detector
+    that ignores the intensity (analysers 0, 45, 90, 135 deg in the channel order)."""
+    flux = np.tensordot(np.asarray(frames, float) - np.asarray(background, float).reshape(1, 4, 1, 1), psf, axes=([2, 3], [0, 1]))
+    s0 = 0.5 * flux.sum(axis=1)
+    s1, s2 = flux[:, 0] - flux[:, 2], flux[:, 1] - flux[:, 3]
+    return np.hypot(s1, s2) / np.maximum(np.abs(s0), 1e-300)
+
+
+def threshold_from_sky(sky_statistics: np.ndarray, p_false_alarm: float) -> float:
+    """The threshold that sky-only statistics exceed with probability ``p_false_alarm`` (their upper quantile); at
+    least 10 / P_fa of them are needed for a quantile worth the name."""
+    sky_statistics = np.ravel(sky_statistics)
+    if sky_statistics.size * p_false_alarm < 10:
+        raise ValueError(f"{sky_statistics.size} sky-only statistics set no threshold at P_fa {p_false_alarm:g} "
+                         f"(need at least {int(np.ceil(10 / p_false_alarm))})")
+    return float(np.quantile(sky_statistics, 1.0 - p_false_alarm))
+
+
+def detection_probability(target_statistics: np.ndarray, threshold: float) -> tuple[float, float]:
+    """(P_d, its binomial standard error) of the statistics with the target over ``threshold``."""
+    hits = np.ravel(target_statistics) > threshold
+    p = float(hits.mean())
+    return p, float(np.sqrt(max(p * (1 - p), 1.0 / hits.size) / hits.size))

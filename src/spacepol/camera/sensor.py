@@ -24,8 +24,8 @@ from .mosaic import IMX250MZR, Layout
 @dataclass(frozen=True)
 class Camera:
     """A micro-polarizer camera. Defaults: a Sony IMX250MZR-class sensor (extinction ratio, read noise, full well
-    and ADC from its datasheet class; quantum efficiency for the near infrared), 1 s exposure; set
-    ``pixel_scale_arcsec`` and ``psf_fwhm_pixels`` for the telescope."""
+    and ADC from its datasheet class; quantum efficiency for the near infrared), 1 s exposure, behind the paper's
+    telescope (aperture, transmittance); set ``pixel_scale_arcsec`` and ``psf_fwhm_pixels`` for yours."""
 
     extinction_ratio: float = 300.0
     quantum_efficiency: float = 0.65
@@ -36,6 +36,8 @@ class Camera:
     exposure_s: float = 1.0
     pixel_scale_arcsec: float = 0.5
     psf_fwhm_pixels: float = 2.0
+    aperture_area_m2: float = 2.544  # the telescope: the paper's A_0 (Table 2)
+    transmittance: float = 0.63  # optics x atmosphere: the paper's tau_0 tau_s = 0.9 x 0.7
     layout: Layout = IMX250MZR
 
     def __post_init__(self):
@@ -43,7 +45,8 @@ class Camera:
                   "read_noise_e": self.read_noise_e >= 0, "dark_current_e_per_s": self.dark_current_e_per_s >= 0,
                   "full_well_e": self.full_well_e > 0, "adc_bits": 1 <= self.adc_bits <= 32,
                   "exposure_s": self.exposure_s > 0, "pixel_scale_arcsec": self.pixel_scale_arcsec > 0,
-                  "psf_fwhm_pixels": self.psf_fwhm_pixels > 0}
+                  "psf_fwhm_pixels": self.psf_fwhm_pixels > 0, "aperture_area_m2": self.aperture_area_m2 > 0,
+                  "transmittance": 0 < self.transmittance <= 1}
         for name, ok in checks.items():
             value = getattr(self, name)
             if not (np.isfinite(value) and ok):

@@ -21,6 +21,7 @@ scenario may override the band irradiance.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,8 +63,9 @@ class TargetLight:
         """{"median", "q05", "q95"} over the draws at each time (lists of length T) of ``photons_m2_s``, ``dolp`` or
         ``aop_deg``."""
         values = getattr(self, quantity)
-        with np.errstate(all="ignore"):
-            q = np.nanpercentile(values, [5, 50, 95], axis=0) if np.isfinite(values).any() else np.full((3, values.shape[1]), np.nan)
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a time with no light in any draw: NaN, said so
+            q = np.nanpercentile(values, [5, 50, 95], axis=0)
         return {"median": q[1].tolist(), "q05": q[0].tolist(), "q95": q[2].tolist()}
 
 

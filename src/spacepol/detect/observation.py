@@ -1,0 +1,153 @@
+"""A pass observed with a micro-polarizer camera: P_d(t) per detector over the material's posterior.
+
+Per time: the target's Stokes flux at the aperture (``detect.target``: each draw of the material), the sky at the
+target's direction, and the camera turn into electrons per analyser channel on the superpixel grid (the target
+through the PSF, the sky per pixel), and the matched filters' deflections into P_d at the fixed false-alarm rate
+(``detect.detection``: their Neyman-Pearson curves, checked by simulation in tests/test_detection.py).
+
+The sky (stated model, the scenario may override its parts):
+- radiance: the CIE standard general sky, type 12 ("clear, low turbidity"; CIE S 011/E:2003, Kittler, Perez and
+  Darula), L(view) / L(zenith) = f(chi) phi(Z) / (f(Z_sun) phi(0)), with chi the view's angle from the sun and Z its
+  zenith angle; its zenith level from ``sky_magnitude_zenith`` (mag arcsec^-2 in the band; default 5.40, what the
+  paper's Table 3 implies) through the paper's zero point (eq 36). The CIE pattern is a visible-light luminance
+  distribution: in the near infrared, where aerosols scatter more evenly, it is an approximation.
+- polarization: single Rayleigh scattering scaled by P_max (``skylight.RayleighSky``), the E-vector perpendicular to
+  the sun - view plane.
+Atmospheric transmission of the target's light is the camera's ``transmittance``; the target's own extinction near
+the horizon and the sky's turbidity are not modelled further.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .detection import deflections, gaussian_psf, neyman_pearson
+from .radiometry import background_photon_flux
+from .target import target_light
+
+# CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
+CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
+DETECTORS = ("intensity", "stokes")
+
+
+def cie_relative_radiance(view_zenith_deg, scattering_deg, sun_zenith_deg, sky=CIE_CLEAR):
+    """L(view) / L(zenith) of the CIE standard general sky."""
+    z, chi, zs = (np.radians(np.asarray(v, float)) for v in (view_zenith_deg, scattering_deg, sun_zenith_deg))
+
+    def gradation(zenith):
+        return 1.0 + sky["a"] * np.exp(sky["b"] / np.maximum(np.cos(zenith), 1e-3))
+
+    def indicatrix(angle):
+        return 1.0 + sky["c"] * (np.exp(sky["d"] * angle) - np.exp(sky["d"] * np.pi / 2)) + sky["e"] * np.cos(angle) ** 2
+
+    return indicatrix(chi) * gradation(z) / (indicatrix(zs) * gradation(0.0))
+
+
+@dataclass
+class Observation:
+    """P_d(t) of each detector over the material's draws, with the pass, the target's light and the sky at each time:
+    ``p_detect`` {detector: (D, T)}, ``deflection`` {detector: (D, T)}, ``sky_photons_arcsec2`` (T,) (photons m^-2
+    s^-1 arcsec^-2), ``sky_dolp`` (T,), ``light`` (detect.target.TargetLight), ``geometry`` (orbit.PassGeometry)."""
+
+    geometry: object
+    light: object
+    sky_photons_arcsec2: np.ndarray
+    sky_dolp: np.ndarray
+    deflection: dict
+    p_detect: dict
+    p_false_alarm: float
+    camera: object
+
+    def to_json(self) -> dict:
+        """``observe.json``'s content (DESIGN.md's fields, units in the key names)."""
+        def band(values):
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # a time with no light in any draw: NaN, said so
+                q = np.nanpercentile(values, [5, 50, 95], axis=0)
+            return q
+
+        flux, dolp, aop = band(self.light.photons_m2_s), band(self.light.dolp), band(self.light.aop_deg)
+        pd = {k: band(v) for k, v in self.p_detect.items()}
+        g = self.geometry
+        rows = []
+        for j, t in enumerate(g.times_utc):
+            def q(a):
+                return {"median": _num(a[1, j]), "q05": _num(a[0, j]), "q95": _num(a[2, j])}
+
+            rows.append({"time_utc": t.isoformat().replace("+00:00", "Z"), "range_km": float(g.range_km[j]),
+                         "elevation_deg": float(g.elevation_deg[j]), "azimuth_deg": float(g.azimuth_deg[j]),
+                         "sun_elevation_deg": float(g.sun_elevation_deg[j]), "phase_angle_deg": float(g.phase_angle_deg[j]),
+                         "sunlit": bool(g.sunlit[j]), "sky_state": g.sky[j],
+                         "target": {"flux_photons_m2_s": q(flux), "dolp": q(dolp), "aop_deg": q(aop)},
+                         "sky": {"radiance_photons_m2_s_arcsec2": float(self.sky_photons_arcsec2[j]),
+                                 "dolp": float(self.sky_dolp[j])},
+                         "p_detect": {k: q(v) for k, v in pd.items()}})
+        lat, lon, height = g.site
+        return {"satellite": g.satellite, "site": {"lat_deg": lat, "lon_deg": lon, "height_m": height},
+                "window": {"start_utc": rows[0]["time_utc"], "end_utc": rows[-1]["time_utc"], "steps": len(rows)},
+                "camera": {k: v for k, v in vars(self.camera).items() if k != "layout"} | {"layout": self.camera.layout.name},
+                "detectors": list(self.p_detect), "times": rows, "p_false_alarm": self.p_false_alarm}
+
+
+def _num(x) -> float | None:
+    return None if not np.isfinite(x) else float(x)
+
+
+def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_false_alarm: float = 1e-3,
+                 sky_magnitude_zenith: float = 5.40, p_max: float = 0.7, stamp_superpixels: int = 9) -> Observation:
+    """P_d over the pass ``geometry`` (with the target's faces) for the material ``model`` at ``draws`` seen by
+    ``camera`` (``camera.sensor.Camera``)."""
+    from ..skylight.rayleigh import RayleighSky
+
+    light = target_light(geometry, model, draws, band_um)
+    view_zenith = 90.0 - geometry.elevation_deg
+    scattering = np.degrees(np.arccos(np.clip(np.sum(geometry.sun_unit * -geometry.to_observer_unit, axis=0), -1, 1)))
+    relative = cie_relative_radiance(np.minimum(view_zenith, 89.0), scattering, 90.0 - geometry.sun_elevation_deg)
+    sky_photons = background_photon_flux(sky_magnitude_zenith) * relative * (geometry.sun_elevation_deg > -0.833)
+    sun = (90.0 - geometry.sun_elevation_deg, geometry.sun_azimuth_deg)
+    sky = RayleighSky(p_max)
+    sky_dolp = np.array([float(sky.dop(view_zenith[j], geometry.azimuth_deg[j], (sun[0][j], sun[1][j])))
+                         for j in range(len(view_zenith))])
+    sky_aop = _sky_aop(geometry)
+    collect = camera.quantum_efficiency * camera.transmittance * camera.aperture_area_m2 * camera.exposure_s
+    total, diff = camera.transmissions
+    angles = np.radians(np.array(camera.layout.order))
+    # the PSF on the superpixel grid (one superpixel = 2 pixels on a side)
+    psf = gaussian_psf(stamp_superpixels, camera.psf_fwhm_pixels / 2.0)
+    pixel_arcsec2 = camera.pixel_scale_arcsec**2
+    n_draws, n_times = light.photons_m2_s.shape
+    out_d = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
+    photons_per_w = light.photons_m2_s / np.where(light.stokes_w_m2[0] > 0, light.stokes_w_m2[0], np.inf)
+    for j in range(n_times):
+        if geometry.elevation_deg[j] <= 0:
+            continue
+        # electrons on one pixel of each channel: the sky through its analyser
+        b = 0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j] * np.cos(2 * (angles - np.radians(sky_aop[j]))))
+        variance = b + camera.dark_current_e_per_s * camera.exposure_s + camera.read_noise_e**2
+        for i in range(n_draws):
+            s = light.stokes_w_m2[:, i, j] * photons_per_w[i, j]  # photons m^-2 s^-1 per Stokes component
+            if not np.all(np.isfinite(s)) or s[0] <= 0:
+                out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0
+                continue
+            # a quarter of the target's light falls on each channel's pixels, which pass their analyser's share
+            electrons = 0.25 * 0.5 * collect * (total * s[0] + diff * (s[1] * np.cos(2 * angles) + s[2] * np.sin(2 * angles)))
+            d = deflections(electrons[:, None, None] * psf, variance)
+            out_d["intensity"][i, j], out_d["stokes"][i, j] = d["intensity"], d["stokes"]
+    p_detect = {k: np.where(np.isfinite(v), neyman_pearson(np.nan_to_num(v), p_false_alarm), np.nan) for k, v in out_d.items()}
+    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera)
+
+
+def _sky_aop(geometry) -> np.ndarray:
+    """The sky's AoP (deg) at the target's direction in the target's sky basis (from the horizontal towards the
+    vertical): single scattering's E-vector, perpendicular to the sun - view plane."""
+    d = geometry.to_observer_unit
+    up = geometry.position_km + geometry.range_km * d
+    up = up / np.linalg.norm(up, axis=0)
+    s_ref = np.cross(up.T, d.T).T
+    s_ref /= np.linalg.norm(s_ref, axis=0)
+    p_ref = np.cross(d.T, s_ref.T).T
+    e = np.cross(geometry.sun_unit.T, d.T).T
+    return np.degrees(np.arctan2(np.sum(e * p_ref, axis=0), np.sum(e * s_ref, axis=0)))

@@ -1,0 +1,51 @@
+"""A pass observed with a micro-polarizer camera (issue 26, items 3 and 5): the CIE sky's normalisation, observe.json's
+fields, P_d at the false-alarm rate where the target sends no light, and the Stokes detector never below intensity."""
+
+import numpy as np
+import pytest
+
+from spacepol.camera.sensor import Camera
+from spacepol.detect.observation import cie_relative_radiance, observe_pass
+from spacepol.orbit import Face, pass_geometry, read_tle
+from spacepol.paths import bundled
+from spacepol.physics.model import Model
+
+SITE = (43 + 8 / 60, 125 + 32 / 60, 200.0)
+
+
+def test_the_cie_clear_sky_is_one_at_the_zenith_and_brightest_near_the_sun():
+    sun_zenith = np.array([20.0, 50.0, 80.0])
+    assert np.allclose(cie_relative_radiance(0.0, sun_zenith, sun_zenith), 1.0)
+    near, far = cie_relative_radiance(50.0, 5.0, 50.0), cie_relative_radiance(50.0, 90.0, 50.0)
+    assert near > 5 * far  # the circumsolar brightening of a clear sky
+
+
+@pytest.fixture(scope="module")
+def observation():
+    tle = read_tle(bundled("tle", "iss_zarya_2014-01-20.tle"))
+    faces = [Face("body", 20.0, "nadir", (0, 0, 1)), Face("panel", 60.0, "sun")]
+    g = pass_geometry(tle, SITE, "2014-01-21T00:33:00Z", "2014-01-21T00:40:00Z", 30.0, faces)
+    rng = np.random.default_rng(0)
+    draws = {"n": rng.normal(1.3, 0.05, 40), "k": rng.normal(7.5, 0.3, 40), "sigma": rng.uniform(0.1, 0.2, 40),
+             "ks": np.full(40, 0.9)}
+    return observe_pass(g, Model.from_string("specular+smith"), draws, Camera(exposure_s=0.01))
+
+
+def test_observe_json_has_designs_fields_and_pd_is_the_false_alarm_rate_without_light(observation):
+    j = observation.to_json()
+    assert {"satellite", "site", "window", "camera", "detectors", "times", "p_false_alarm"} <= set(j)
+    row = j["times"][0]
+    assert {"time_utc", "range_km", "elevation_deg", "sun_elevation_deg", "phase_angle_deg", "sunlit", "target", "sky",
+            "p_detect"} <= set(row)
+    assert set(row["target"]) == {"flux_photons_m2_s", "dolp", "aop_deg"} and set(row["p_detect"]) == {"intensity", "stokes"}
+    dark = observation.light.lit_faces == 0
+    assert dark.any() and (~dark).any()
+    for detector, p in observation.p_detect.items():
+        assert np.allclose(p[:, dark & (observation.geometry.elevation_deg > 0)], observation.p_false_alarm)
+        assert np.all((p[np.isfinite(p)] >= observation.p_false_alarm - 1e-12) & (p[np.isfinite(p)] <= 1.0))
+
+
+def test_the_stokes_detector_is_never_below_intensity(observation):
+    d_i, d_s = observation.deflection["intensity"], observation.deflection["stokes"]
+    seen = np.isfinite(d_i)
+    assert np.all(d_s[seen] >= d_i[seen] * (1 - 1e-12))

@@ -49,3 +49,30 @@ def test_the_stokes_detector_is_never_below_intensity(observation):
     d_i, d_s = observation.deflection["intensity"], observation.deflection["stokes"]
     seen = np.isfinite(d_i)
     assert np.all(d_s[seen] >= d_i[seen] * (1 - 1e-12))
+
+
+def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_line(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from test_contrast import _run_dir
+
+    run = _run_dir(tmp_path, spread=1.0)
+    tle = bundled("tle", "iss_zarya_2014-01-20.tle")
+    args = [sys.executable, "-m", "spacepol.cli", "observe", str(run), "--tle", str(tle), "--site", "43.1333,125.5333,200",
+            "--start", "2014-01-21T00:33:00Z", "--end", "2014-01-21T00:39:00Z", "--step", "30", "--draws", "50"]
+    done = subprocess.run(args + ["--out", str(tmp_path / "obs")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    content = json.loads((tmp_path / "obs" / "observe.json").read_text())
+    assert content["satellite"] == "ISS (ZARYA)" and len(content["times"]) == 13 and content["p_false_alarm"] == 1e-3
+    assert (tmp_path / "obs" / "light_curves.png").stat().st_size > 0 and "P_d" in (tmp_path / "obs" / "report.html").read_text()
+    assert "best P_d" in done.stdout
+    for bad, words in ((["--site", "95,125"], "--site '95,125'"), (["--start", "2014-01-21T00:33:00"], "UTC offset"),
+                       (["--tle", str(tmp_path / "none.tle")], "file not found")):
+        argv = list(args)
+        flag = bad[0]
+        argv[argv.index(flag) + 1] = bad[1]
+        failed = subprocess.run(argv + ["--out", str(tmp_path / "bad")], capture_output=True, text=True)
+        assert failed.returncode == 2 and words in failed.stderr, failed.stderr
+        assert len(failed.stderr.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()

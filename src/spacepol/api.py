@@ -376,6 +376,83 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
     return Contrast(content, per_case)
 
 
+def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, satellite: str | None = None, target=None,
+            camera=None, draws: int = 200, seed: int = 0, p_false_alarm: float = 1e-3, band_um=(1.5, 1.8), out=None,
+            progress: bool = False):
+    """A pass of the satellite of ``tle`` (a TLE file; ``satellite`` picks one of several) over ``site`` ((lat_deg,
+    lon_deg[, height_m]) or "LAT,LON[,HEIGHT_M]") from ``start`` to ``end`` (ISO 8601 with offset) every ``step_s``
+    seconds, its faces (``target``: a TOML file of [[faces]] or a list of ``orbit.Face``; default a 1 m cube with a
+    4 m^2 sun-tracking panel) made of the Result's material (``draws`` posterior draws, n and k at the band's centre
+    for a run over several wavelengths), seen by ``camera`` (a TOML file's [camera], a ``camera.sensor.Camera``, or
+    the default). Returns the ``detect.observation.Observation``: P_d(t) per detector at ``p_false_alarm``, light
+    curves with their posterior bands; with ``out`` observe.json, light_curves.png and report.html."""
+    from .camera.sensor import Camera, camera_from_toml
+    from .detect.contrast import material_samples
+    from .detect.observation import observe_pass
+    from .detect.scenario import default_scenario
+    from .orbit import default_faces, faces_from_toml, pass_geometry, read_tle
+
+    if out is not None:
+        from .io.output import check_output_dir
+
+        out = check_output_dir(Path(out))
+    site = _site(site)
+    if not (isinstance(draws, int) and draws >= 1):
+        raise ParameterError(f"--draws {draws}: need a whole number of at least 1")
+    if not 0 < p_false_alarm < 0.5:
+        raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
+    faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
+    camera = Camera() if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+    element_set = read_tle(tle, satellite)
+    geometry = pass_geometry(element_set, site, start, end, step_s, faces)
+    scenario = default_scenario()
+    scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
+    inner, params, material = material_samples(result.model, result.samples(), scenario,
+                                               result.summary.get("spec", result.summary["model"]))
+    rng = np.random.default_rng(seed)
+    size = len(next(iter(params.values())))
+    pick = rng.choice(size, min(draws, size), replace=False)
+    chosen = {k: np.asarray(v)[pick] for k, v in params.items()}
+    if progress:
+        print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
+              f"{result.summary['model']}", file=sys.stderr)
+    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm)
+    if out is not None:
+        from .report.observe_report import write_observe_report
+
+        assumptions = [
+            f"Satellite {element_set.name} from {element_set.source} (SGP4, skyfield), site {site[0]:.4f}, {site[1]:.4f} deg, "
+            f"{site[2]:g} m; {len(geometry.times_utc)} times every {step_s:g} s.",
+            f"Target: {len(faces)} faces ({', '.join(f'{f.name} {f.area_m2:g} m^2 {f.orientation}' for f in faces)}); "
+            "shadows between faces and light reflected between them are left out.",
+            f"Material: {len(pick)} draws of the posterior of {result.summary['model']}; {material['rule']}.",
+            f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
+            "5.40 mag arcsec^-2 at the zenith (the paper's), Rayleigh polarization with P_max 0.7.",
+            f"Camera: {camera.layout.name}, extinction ratio {camera.extinction_ratio:g}, QE {camera.quantum_efficiency:g}, read "
+            f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s, {camera.pixel_scale_arcsec:g} arcsec pixels, "
+            f"PSF FWHM {camera.psf_fwhm_pixels:g} px, aperture {camera.aperture_area_m2:g} m^2.",
+            f"Detectors: intensity and Stokes (four analyser channels) matched filters; P_d from their Neyman-Pearson curves "
+            f"at P_fa = {p_false_alarm:g} (checked by simulation in the tests).",
+        ]
+        write_observe_report(observation, out, assumptions)
+    return observation
+
+
+def _site(value) -> tuple[float, float, float]:
+    """A site as "LAT,LON[,HEIGHT_M]" text or a tuple, checked."""
+    text = value if isinstance(value, str) else ",".join(str(v) for v in value)
+    try:
+        numbers = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise ParameterError(f"--site '{text}': expected LAT,LON[,HEIGHT_M] in degrees and metres") from None
+    if len(numbers) not in (2, 3) or not all(np.isfinite(numbers)):
+        raise ParameterError(f"--site '{text}': expected LAT,LON[,HEIGHT_M] in degrees and metres")
+    lat, lon, height = (numbers + [0.0])[:3]
+    if not (-90 <= lat <= 90 and -180 <= lon <= 360):
+        raise ParameterError(f"--site '{text}': latitude in [-90, 90], longitude in [-180, 360] deg")
+    return lat, lon, height
+
+
 def _direction(value) -> tuple[float, float]:
     """A direction as ``"ZENITH,AZIMUTH"`` text or a pair, in degrees, checked."""
     text = value if isinstance(value, str) else ",".join(str(v) for v in value)

@@ -363,3 +363,22 @@ def contrast(args) -> int:
     print(report["dominance"])
     print(f"wrote {out}/contrast.json, table3.md, contrast_histograms.png, report.html")
     return 0
+
+
+def observe(args) -> int:
+    """``invert-mcmc observe``: a run folder's Result over a satellite's pass (``api.observe``); prints where the
+    target is detectable."""
+    from .api import observe as observe_pass
+    from .infer.result import Result
+
+    out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "observe")
+    observation = observe_pass(Result.load(args.run_dir), args.tle, args.site, args.start, args.end, step_s=args.step,
+                               satellite=args.satellite, target=args.target, camera=args.camera, draws=args.draws,
+                               seed=args.seed, out=out, progress=True)
+    rows = observation.to_json()["times"]
+    for name in observation.p_detect:
+        best = max(rows, key=lambda r: r["p_detect"][name]["median"] or 0.0)
+        print(f"{name}: best P_d {best['p_detect'][name]['median']:.3f} at {best['time_utc']} "
+              f"(elevation {best['elevation_deg']:.1f} deg, phase {best['phase_angle_deg']:.1f} deg)")
+    print(f"wrote {out}/observe.json, light_curves.png, report.html")
+    return 0

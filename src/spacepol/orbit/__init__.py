@@ -2,7 +2,8 @@
 site, the sun, whether the satellite is sunlit and the sky is in daylight, the phase angle, and each face's
 incidence, reflection and azimuth angles in its own frame."""
 
+from .faces import default_faces, faces_from_toml
 from .pass_geometry import Face, PassGeometry, pass_geometry
 from .tle import TLE, read_tle
 
-__all__ = ["Face", "PassGeometry", "TLE", "pass_geometry", "read_tle"]
+__all__ = ["Face", "PassGeometry", "TLE", "default_faces", "faces_from_toml", "pass_geometry", "read_tle"]

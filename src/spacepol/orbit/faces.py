@@ -1,0 +1,50 @@
+"""A target's faces from a TOML file (``[[faces]]`` tables: name, area_m2, orientation, normal), and the default
+target: a 1 m cube bus in the orbit frame with a 4 m^2 sun-tracking panel."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from ..errors import ParameterError
+from .pass_geometry import Face
+
+FACE_KEYS = {"name", "area_m2", "orientation", "normal"}
+
+
+def default_faces() -> list[Face]:
+    """A 1 m cube (six 1 m^2 faces, nadir-pointing: +-x along and against the velocity, +-y across, +-z to and away
+    from the Earth) and a 4 m^2 panel tracking the sun."""
+    axes = {"ram": (1, 0, 0), "wake": (-1, 0, 0), "starboard": (0, 1, 0), "port": (0, -1, 0), "nadir": (0, 0, 1),
+            "zenith": (0, 0, -1)}
+    return [Face(name, 1.0, "nadir", normal) for name, normal in axes.items()] + [Face("solar_panel", 4.0, "sun")]
+
+
+def faces_from_toml(path) -> list[Face]:
+    """The ``[[faces]]`` of a target TOML file; an unknown key, a missing area or a bad value is one line naming the
+    face."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"--target {path}: file not found")
+    try:
+        tables = tomllib.loads(path.read_text(encoding="utf-8")).get("faces")
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"--target {path}: not valid TOML ({exc})") from None
+    if not isinstance(tables, list) or not tables:
+        raise ParameterError(f"--target {path}: no [[faces]] tables (each with name, area_m2, orientation, normal)")
+    faces = []
+    for k, table in enumerate(tables, start=1):
+        unknown = sorted(set(table) - FACE_KEYS)
+        if unknown:
+            raise ParameterError(f"--target {path}: face {k} has no key {', '.join(unknown)} (known: {', '.join(sorted(FACE_KEYS))})")
+        if "area_m2" not in table:
+            raise ParameterError(f"--target {path}: face {k} needs area_m2")
+        try:
+            faces.append(Face(str(table.get("name", f"face{k}")), float(table["area_m2"]), str(table.get("orientation", "nadir")),
+                              tuple(float(v) for v in table.get("normal", (0.0, 0.0, 1.0)))))
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"--target {path}: face {k}: {exc}") from None
+    names = [f.name for f in faces]
+    if len(set(names)) != len(names):
+        raise ParameterError(f"--target {path}: two faces share a name ({', '.join(sorted({n for n in names if names.count(n) > 1}))})")
+    return faces

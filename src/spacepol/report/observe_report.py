@@ -1,0 +1,80 @@
+"""Files of ``invert-mcmc observe``: observe.json, light_curves.png (the target's flux, DoLP and AoP with their
+posterior bands, the sky's DoLP, and P_d(t) per detector), report.html."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..io.atomic import atomic_path, save_figure, write_json
+from . import html as H
+
+
+def light_curves_figure(observation, fig=None) -> Figure:
+    """Four panels over the pass: photon flux at the aperture, DoLP (target and sky), AoP, and P_d per detector;
+    medians with the 5-95 % band of the material's posterior."""
+    g = observation.geometry
+    minutes = np.array([(t - g.times_utc[0]).total_seconds() / 60.0 for t in g.times_utc])
+    fig = fig or Figure(figsize=(8.0, 9.0), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True)
+    light = observation.light
+
+    def band(ax, values, colour, label):
+        with np.errstate(all="ignore"):
+            import warnings
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                lo, med, hi = np.nanpercentile(values, [5, 50, 95], axis=0)
+        ax.fill_between(minutes, lo, hi, color=colour, alpha=0.3, lw=0)
+        ax.plot(minutes, med, "-", color=colour, label=label)
+
+    band(axes[0], np.where(light.photons_m2_s > 0, light.photons_m2_s, np.nan), "C0", "target")
+    axes[0].set_yscale("log")
+    axes[0].set_ylabel("photons m^-2 s^-1")
+    band(axes[1], light.dolp, "C0", "target DoLP")
+    axes[1].plot(minutes, observation.sky_dolp, "--", color="C1", label="sky DoLP")
+    axes[1].set_ylabel("DoLP")
+    band(axes[2], light.aop_deg, "C0", "target AoP")
+    axes[2].set_ylabel("AoP (deg from horizontal)")
+    for k, (name, values) in enumerate(observation.p_detect.items()):
+        band(axes[3], values, f"C{k + 2}", name)
+    axes[3].axhline(observation.p_false_alarm, color="k", lw=0.8, ls=":", label="P_fa")
+    axes[3].set_ylabel("P_d")
+    axes[3].set_xlabel(f"minutes after {g.times_utc[0].isoformat().replace('+00:00', 'Z')}")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"{g.satellite} over ({g.site[0]:.2f}, {g.site[1]:.2f}): posterior medians and 90 % bands", fontsize=10)
+    return fig
+
+
+def write_observe_report(observation, out: Path, assumptions: list[str]) -> dict:
+    """observe.json, light_curves.png and report.html in ``out``; returns observe.json's content."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    content = observation.to_json() | {"assumptions": assumptions}
+    write_json(out / "observe.json", content)
+    save_figure(light_curves_figure(observation), out / "light_curves.png")
+    rows = []
+    for row in content["times"][:: max(1, len(content["times"]) // 30)]:
+        pd = row["p_detect"]
+        rows.append([row["time_utc"], f"{row['elevation_deg']:.1f}", f"{row['phase_angle_deg']:.1f}", row["sky_state"],
+                     _q(row["target"]["flux_photons_m2_s"], "{:.3g}"), _q(row["target"]["dolp"], "{:.3f}"),
+                     f"{row['sky']['dolp']:.2f}"] + [_q(pd[d], "{:.3f}") for d in content["detectors"]])
+    sections = [("Pass, target and camera", H.bullets(assumptions)),
+                ("Light curves and detection probability", H.image(H.png_file_to_data_uri(out / "light_curves.png"))),
+                ("Per time (median [5 %, 95 %] over the material's posterior)", H.table(
+                    ["time (UTC)", "elevation (deg)", "phase (deg)", "sky", "flux (photons m^-2 s^-1)", "target DoLP",
+                     "sky DoLP"] + [f"P_d {d}" for d in content["detectors"]], rows))]
+    with atomic_path(out / "report.html") as tmp:
+        tmp.write_text(H.page(f"spacepol observe: {content['satellite']}", sections), encoding="utf-8")
+    return content
+
+
+def _q(q: dict, fmt: str) -> str:
+    if q["median"] is None:
+        return "no light"
+    return f"{fmt.format(q['median'])} [{fmt.format(q['q05'])}, {fmt.format(q['q95'])}]"

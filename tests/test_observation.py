@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from spacepol.camera.sensor import Camera
-from spacepol.detect.observation import cie_relative_radiance, observe_pass
+from spacepol.detect.observation import auto_exposure_s, cie_relative_radiance, observe_pass
 from spacepol.orbit import Face, pass_geometry, read_tle
 from spacepol.paths import bundled
 from spacepol.physics.model import Model
@@ -28,7 +28,8 @@ def observation():
     rng = np.random.default_rng(0)
     draws = {"n": rng.normal(1.3, 0.05, 40), "k": rng.normal(7.5, 0.3, 40), "sigma": rng.uniform(0.1, 0.2, 40),
              "ks": np.full(40, 0.9)}
-    return observe_pass(g, Model.from_string("specular+smith"), draws, Camera(exposure_s=0.01))
+    camera = Camera(exposure_s=auto_exposure_s(Camera(), g))  # the brightest sky of the pass at half the well
+    return observe_pass(g, Model.from_string("specular+smith"), draws, camera)
 
 
 def test_observe_json_has_designs_fields_and_pd_is_the_false_alarm_rate_without_light(observation):
@@ -49,6 +50,9 @@ def test_the_stokes_detector_is_never_below_intensity(observation):
     d_i, d_s = observation.deflection["intensity"], observation.deflection["stokes"]
     seen = np.isfinite(d_i)
     assert np.all(d_s[seen] >= d_i[seen] * (1 - 1e-12))
+    assert np.nanmax(d_i) > 1.0  # the target is seen somewhere in the pass (the check above is not of zeros)
+    # the exposure chosen for the pass keeps the sky out of saturation: half the well at its brightest
+    assert 1e-7 < observation.camera.exposure_s < 1e-2
 
 
 def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_line(tmp_path):

@@ -402,9 +402,15 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     if not 0 < p_false_alarm < 0.5:
         raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
     faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
-    camera = Camera() if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+    camera = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
     element_set = read_tle(tle, satellite)
     geometry = pass_geometry(element_set, site, start, end, step_s, faces)
+    if not camera.exposure_set:  # no exposure given: the one that keeps the brightest sky of the pass at half the well
+        from dataclasses import replace
+
+        from .detect.observation import auto_exposure_s
+
+        camera = replace(camera, exposure_s=auto_exposure_s(camera, geometry), exposure_set=True)
     scenario = default_scenario()
     scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
     inner, params, material = material_samples(result.model, result.samples(), scenario,
@@ -429,7 +435,8 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
             f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
             "5.40 mag arcsec^-2 at the zenith (the paper's), Rayleigh polarization with P_max 0.7.",
             f"Camera: {camera.layout.name}, extinction ratio {camera.extinction_ratio:g}, QE {camera.quantum_efficiency:g}, read "
-            f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s, {camera.pixel_scale_arcsec:g} arcsec pixels, "
+            f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s (set where not given: the brightest sky of the "
+            f"pass at half the full well), {camera.pixel_scale_arcsec:g} arcsec pixels, "
             f"PSF FWHM {camera.psf_fwhm_pixels:g} px, aperture {camera.aperture_area_m2:g} m^2.",
             f"Detectors: intensity and Stokes (four analyser channels) matched filters; P_d from their Neyman-Pearson curves "
             f"at P_fa = {p_false_alarm:g} (checked by simulation in the tests).",

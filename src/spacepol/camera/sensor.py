@@ -39,6 +39,7 @@ class Camera:
     aperture_area_m2: float = 2.544  # the telescope: the paper's A_0 (Table 2)
     transmittance: float = 0.63  # optics x atmosphere: the paper's tau_0 tau_s = 0.9 x 0.7
     layout: Layout = IMX250MZR
+    exposure_set: bool = True  # False: ``observe`` chooses the exposure for the pass's sky (camera files without one)
 
     def __post_init__(self):
         checks = {"extinction_ratio": self.extinction_ratio > 1, "quantum_efficiency": 0 < self.quantum_efficiency <= 1,
@@ -102,11 +103,11 @@ def camera_from_toml(path) -> Camera:
         raise ParameterError(f"{path}: file not found") from None
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc})") from None
-    known = {f.name for f in fields(Camera) if f.name != "layout"}
+    known = {f.name for f in fields(Camera) if f.name not in ("layout", "exposure_set")}
     unknown = sorted(set(table) - known)
     if unknown:
         raise ParameterError(f"{path}: [camera] has no key {', '.join(unknown)} (known: {', '.join(sorted(known))})")
     for key, value in table.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ParameterError(f"{path}: [camera] {key} = {value!r} must be a number in the unit its name gives")
-    return Camera(**table)
+    return Camera(**table, exposure_set="exposure_s" in table)

@@ -26,7 +26,7 @@ import numpy as np
 
 from .detection import deflections, gaussian_psf, neyman_pearson
 from .radiometry import background_photon_flux
-from .target import target_light
+from .target import solar_band, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
@@ -60,6 +60,8 @@ class Observation:
     p_detect: dict
     p_false_alarm: float
     camera: object
+    sky_aop_deg: np.ndarray | None = None  # (T,) the sky's AoP in the target's sky basis
+    photons_per_watt: float = 0.0  # the band's photons per joule: Stokes W m^-2 -> photons m^-2 s^-1
 
     def to_json(self) -> dict:
         """``observe.json``'s content (DESIGN.md's fields, units in the key names)."""
@@ -88,7 +90,8 @@ class Observation:
         lat, lon, height = g.site
         return {"satellite": g.satellite, "site": {"lat_deg": lat, "lon_deg": lon, "height_m": height},
                 "window": {"start_utc": rows[0]["time_utc"], "end_utc": rows[-1]["time_utc"], "steps": len(rows)},
-                "camera": {k: v for k, v in vars(self.camera).items() if k != "layout"} | {"layout": self.camera.layout.name},
+                "camera": {k: v for k, v in vars(self.camera).items() if k not in ("layout", "exposure_set")}
+                | {"layout": self.camera.layout.name},
                 "detectors": list(self.p_detect), "times": rows, "p_false_alarm": self.p_false_alarm}
 
 
@@ -104,9 +107,7 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
 
     light = target_light(geometry, model, draws, band_um)
     view_zenith = 90.0 - geometry.elevation_deg
-    scattering = np.degrees(np.arccos(np.clip(np.sum(geometry.sun_unit * -geometry.to_observer_unit, axis=0), -1, 1)))
-    relative = cie_relative_radiance(np.minimum(view_zenith, 89.0), scattering, 90.0 - geometry.sun_elevation_deg)
-    sky_photons = background_photon_flux(sky_magnitude_zenith) * relative * (geometry.sun_elevation_deg > -0.833)
+    sky_photons = sky_photons_at(geometry, sky_magnitude_zenith)
     sun = (90.0 - geometry.sun_elevation_deg, geometry.sun_azimuth_deg)
     sky = RayleighSky(p_max)
     sky_dolp = np.array([float(sky.dop(view_zenith[j], geometry.azimuth_deg[j], (sun[0][j], sun[1][j])))
@@ -120,24 +121,51 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
     pixel_arcsec2 = camera.pixel_scale_arcsec**2
     n_draws, n_times = light.photons_m2_s.shape
     out_d = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
-    photons_per_w = light.photons_m2_s / np.where(light.stokes_w_m2[0] > 0, light.stokes_w_m2[0], np.inf)
+    irradiance, photons = solar_band(*band_um)
+    per_watt = photons / irradiance  # the band's photons per joule
     for j in range(n_times):
         if geometry.elevation_deg[j] <= 0:
             continue
         # electrons on one pixel of each channel: the sky through its analyser
+        if np.max(0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j])) > camera.full_well_e:
+            out_d["intensity"][:, j] = out_d["stokes"][:, j] = 0.0  # the sky alone fills the wells
+            continue
         b = 0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j] * np.cos(2 * (angles - np.radians(sky_aop[j]))))
         variance = b + camera.dark_current_e_per_s * camera.exposure_s + camera.read_noise_e**2
         for i in range(n_draws):
-            s = light.stokes_w_m2[:, i, j] * photons_per_w[i, j]  # photons m^-2 s^-1 per Stokes component
+            s = light.stokes_w_m2[:, i, j] * per_watt  # photons m^-2 s^-1 per Stokes component
             if not np.all(np.isfinite(s)) or s[0] <= 0:
                 out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0
                 continue
             # a quarter of the target's light falls on each channel's pixels, which pass their analyser's share
             electrons = 0.25 * 0.5 * collect * (total * s[0] + diff * (s[1] * np.cos(2 * angles) + s[2] * np.sin(2 * angles)))
+            if np.max(electrons[:, None, None] * psf * 4 + b[:, None, None]) > camera.full_well_e:
+                out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0  # saturated: the filters see a flat top
+                continue
             d = deflections(electrons[:, None, None] * psf, variance)
             out_d["intensity"][i, j], out_d["stokes"][i, j] = d["intensity"], d["stokes"]
     p_detect = {k: np.where(np.isfinite(v), neyman_pearson(np.nan_to_num(v), p_false_alarm), np.nan) for k, v in out_d.items()}
-    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera)
+    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera, sky_aop, per_watt)
+
+
+def sky_photons_at(geometry, sky_magnitude_zenith: float = 5.40) -> np.ndarray:
+    """(T,) the sky's radiance at the target's direction (photons m^-2 s^-1 arcsec^-2; 0 after sunset)."""
+    view_zenith = 90.0 - geometry.elevation_deg
+    scattering = np.degrees(np.arccos(np.clip(np.sum(geometry.sun_unit * -geometry.to_observer_unit, axis=0), -1, 1)))
+    relative = cie_relative_radiance(np.minimum(view_zenith, 89.0), scattering, 90.0 - geometry.sun_elevation_deg)
+    return background_photon_flux(sky_magnitude_zenith) * relative * (geometry.sun_elevation_deg > -0.833)
+
+
+def auto_exposure_s(camera, geometry, sky_magnitude_zenith: float = 5.40, fill: float = 0.5) -> float:
+    """The exposure an observer would set: the brightest sky the target is seen against (above the horizon) fills
+    ``fill`` of the full well, rounded down to 1, 2 or 5 x 10^k s."""
+    above = geometry.elevation_deg > 0
+    sky = sky_photons_at(geometry, sky_magnitude_zenith)[above] if above.any() else np.zeros(1)
+    rate = camera.quantum_efficiency * camera.transmittance * camera.aperture_area_m2 * camera.pixel_scale_arcsec**2 \
+        * 0.5 * camera.transmissions[0] * float(np.max(sky)) + camera.dark_current_e_per_s
+    seconds = fill * camera.full_well_e / rate
+    decade = 10.0 ** np.floor(np.log10(seconds))
+    return float(max(step * decade for step in (1.0, 2.0, 5.0) if step * decade <= seconds))
 
 
 def _sky_aop(geometry) -> np.ndarray:

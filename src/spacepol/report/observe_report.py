@@ -51,13 +51,31 @@ def light_curves_figure(observation, fig=None) -> Figure:
     return fig
 
 
-def write_observe_report(observation, out: Path, assumptions: list[str]) -> dict:
-    """observe.json, light_curves.png and report.html in ``out``; returns observe.json's content."""
+def montage_times(observation, count: int = 4) -> list[int]:
+    """Up to ``count`` times for the frame montage: the one where the intensity detector does best and others spread
+    over the times the satellite is above the horizon."""
+    above = np.flatnonzero(observation.geometry.elevation_deg > 0)
+    if not above.size:
+        return []
+    pd = np.nan_to_num(np.nanmedian(observation.p_detect["intensity"], axis=0)) if observation.p_detect else np.zeros(0)
+    best = int(above[np.argmax(pd[above])]) if pd.size else int(above[0])
+    spread = above[np.unique(np.linspace(0, above.size - 1, count).round().astype(int))]
+    return sorted({best, *[int(j) for j in spread]})[:count]
+
+
+def write_observe_report(observation, out: Path, assumptions: list[str], seed: int = 0) -> dict:
+    """observe.json, light_curves.png, frames.png (simulated exposures at a few times) and report.html in ``out``;
+    returns observe.json's content."""
+    from ..detect.frames import montage_figure
+
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     content = observation.to_json() | {"assumptions": assumptions}
     write_json(out / "observe.json", content)
     save_figure(light_curves_figure(observation), out / "light_curves.png")
+    times = montage_times(observation)
+    if times:
+        save_figure(montage_figure(observation, times, np.random.default_rng(seed)), out / "frames.png")
     rows = []
     for row in content["times"][:: max(1, len(content["times"]) // 30)]:
         pd = row["p_detect"]
@@ -66,6 +84,8 @@ def write_observe_report(observation, out: Path, assumptions: list[str]) -> dict
                      f"{row['sky']['dolp']:.2f}"] + [_q(pd[d], "{:.3f}") for d in content["detectors"]])
     sections = [("Pass, target and camera", H.bullets(assumptions)),
                 ("Light curves and detection probability", H.image(H.png_file_to_data_uri(out / "light_curves.png"))),
+                ("Simulated exposures", H.image(H.png_file_to_data_uri(out / "frames.png")) if times else
+                 H.paragraph("The satellite is never above the horizon in this window.")),
                 ("Per time (median [5 %, 95 %] over the material's posterior)", H.table(
                     ["time (UTC)", "elevation (deg)", "phase (deg)", "sky", "flux (photons m^-2 s^-1)", "target DoLP",
                      "sky DoLP"] + [f"P_d {d}" for d in content["detectors"]], rows))]

@@ -26,7 +26,7 @@ import numpy as np
 
 from .detection import deflections, gaussian_psf, neyman_pearson
 from .radiometry import background_photon_flux
-from .target import solar_band, target_light
+from .target import sky_basis, solar_band, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
@@ -169,13 +169,8 @@ def auto_exposure_s(camera, geometry, sky_magnitude_zenith: float = 5.40, fill: 
 
 
 def _sky_aop(geometry) -> np.ndarray:
-    """The sky's AoP (deg) at the target's direction in the target's sky basis (from the horizontal towards the
-    vertical): single scattering's E-vector, perpendicular to the sun - view plane."""
-    d = geometry.to_observer_unit
-    up = geometry.position_km + geometry.range_km * d
-    up = up / np.linalg.norm(up, axis=0)
-    s_ref = np.cross(up.T, d.T).T
-    s_ref /= np.linalg.norm(s_ref, axis=0)
-    p_ref = np.cross(d.T, s_ref.T).T
-    e = np.cross(geometry.sun_unit.T, d.T).T
+    """The sky's AoP (deg) at the target's direction in the target's sky basis (``target.sky_basis``): single
+    scattering's E-vector, perpendicular to the sun - view plane."""
+    s_ref, p_ref = sky_basis(geometry)
+    e = np.cross(geometry.sun_unit.T, geometry.to_observer_unit.T).T
     return np.degrees(np.arctan2(np.sum(e * p_ref, axis=0), np.sum(e * s_ref, axis=0)))

@@ -69,12 +69,21 @@ class TargetLight:
         return {"median": q[1].tolist(), "q05": q[0].tolist(), "q95": q[2].tolist()}
 
 
-def _rotation_to_sky(normals: np.ndarray, to_observer: np.ndarray, up: np.ndarray) -> np.ndarray:
-    """The angle (rad) that turns a face's s vector (n x d) into the sky's (u x d) about d, per time (3, T) inputs."""
+def sky_basis(geometry) -> tuple[np.ndarray, np.ndarray]:
+    """(s, p) unit vectors (3, T) of the observer's sky basis for the light arriving along ``to_observer_unit``:
+    s = u x d horizontal (u the site's geocentric vertical), p = d x s; AoP runs from s towards p."""
+    d = geometry.to_observer_unit
+    up = geometry.position_km + geometry.range_km * d
+    up = up / np.linalg.norm(up, axis=0)
+    s = np.cross(up.T, d.T).T
+    s /= np.linalg.norm(s, axis=0)
+    return s, np.cross(d.T, s.T).T
+
+
+def _rotation_to_sky(normals: np.ndarray, to_observer: np.ndarray, s_sky: np.ndarray) -> np.ndarray:
+    """The angle (rad) that turns a face's s vector (n x d) into the sky's ``s_sky`` about d, per time (3, T) inputs."""
     s_face = np.cross(normals.T, to_observer.T).T
-    s_sky = np.cross(up.T, to_observer.T).T
     s_face /= np.maximum(np.linalg.norm(s_face, axis=0), 1e-300)
-    s_sky /= np.maximum(np.linalg.norm(s_sky, axis=0), 1e-300)
     return np.arctan2(np.sum(np.cross(s_face.T, s_sky.T).T * to_observer, axis=0), np.sum(s_face * s_sky, axis=0))
 
 
@@ -92,8 +101,7 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
     params = {k: np.atleast_1d(np.asarray(v, float)) for k, v in draws.items() if k in names}
     n_draws = max((len(v) for v in params.values()), default=1)
     n_times = len(geometry.times_utc)
-    up = (geometry.position_km + geometry.range_km * geometry.to_observer_unit)
-    up /= np.linalg.norm(up, axis=0)
+    s_sky, _ = sky_basis(geometry)
     stokes = np.zeros((4, n_draws, n_times))
     lit_faces = np.zeros(n_times, int)
     for k, face in enumerate(geometry.faces):
@@ -106,7 +114,7 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         s = np.asarray(model.evaluate(params, g).stokes, float).reshape(4, -1, len(rows))  # (4, D or 1, rows) sr^-1
         ti, tr = np.radians(geometry.theta_i_deg[rows, k]), np.radians(geometry.theta_r_deg[rows, k])
         scale = irradiance * np.cos(ti) * face.area_m2 * np.cos(tr) / (geometry.range_km[rows] * 1e3) ** 2
-        psi = _rotation_to_sky(geometry.normals(k)[:, rows], geometry.to_observer_unit[:, rows], up[:, rows])
+        psi = _rotation_to_sky(geometry.normals(k)[:, rows], geometry.to_observer_unit[:, rows], s_sky[:, rows])
         c, sn = np.cos(2 * psi), np.sin(2 * psi)
         rotated = np.stack([s[0], c * s[1] + sn * s[2], -sn * s[1] + c * s[2], s[3]])
         stokes[:, :, rows] += rotated * scale

@@ -55,7 +55,8 @@ def test_the_almanac_check_fails_for_an_hour_off():
     assert abs(sun.zenith_deg - zen) > 0.05 or abs((sun.azimuth_deg - az + 180) % 360 - 180) > 0.05
 
 
-@pytest.mark.parametrize("label", [pytest.param("today", marks=pytest.mark.slow), "in five years"])
+@pytest.mark.slow  # two CLI processes per date; the sun for both dates is checked in-process above
+@pytest.mark.parametrize("label", list(DATES))
 def test_sky_and_contrast_commands_run_for_today_and_five_years_ahead(tmp_path, label):
     iso = DATES[label].isoformat()
     sky = subprocess.run([sys.executable, "-m", "spacepol.cli", "sky", "--lat", str(SITE[0]), "--lon", str(SITE[1]),

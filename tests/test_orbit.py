@@ -117,6 +117,8 @@ def test_a_damaged_or_ambiguous_tle_is_one_line(tmp_path, tle):
     with pytest.raises(SpacepolError, match="holds 2 satellites"):
         read_tle(two)
     assert read_tle(two, "iss copy").name == "ISS COPY" and read_tle(two, "25544").name == "ISS"
+    with pytest.raises(SpacepolError, match="file not found"):
+        read_tle(tmp_path / "none.tle")
     with pytest.raises(SpacepolError, match="no satellite 'HST'"):
         read_tle(two, "HST")
     with pytest.raises(SpacepolError, match="days from the window"):

@@ -8,6 +8,7 @@ import pytest
 from spacepol.detect.target import solar_band, target_light
 from spacepol.orbit import Face, pass_geometry, read_tle
 from spacepol.paths import bundled
+from spacepol.physics.geometry import Geometry
 from spacepol.physics.model import Model
 
 SITE = (43 + 8 / 60, 125 + 32 / 60, 200.0)
@@ -80,3 +81,41 @@ def test_specular_light_is_polarized_perpendicular_to_the_scattering_plane_on_th
         assert np.all((light.dolp[j, seen] > 0.01) & (light.dolp[j, seen] < 1.0))
     # the control: the AoP 90 deg off (polarization in the scattering plane) is far from it
     assert np.abs((light.aop_deg[0, seen] - (expected[seen] + 90.0) + 90.0) % 180.0 - 90.0).min() > 45.0
+
+
+def test_the_chain_gives_contrasts_target_dop_at_table_3s_geometry():
+    """Table 3's target: theta_i 30 deg, dphi 180 deg, theta_r over [0, 80] deg. One face seen along those directions
+    through the pass chain (its Stokes rotated into the sky basis and back to a DoLP) gives the DOP that ``contrast``
+    computes for the same posterior draws (``detect.contrast.target_dop_grid``), to rounding."""
+    from datetime import datetime, timezone
+
+    from spacepol.detect.contrast import target_dop_grid
+    from spacepol.detect.scenario import default_scenario
+    from spacepol.orbit.pass_geometry import PassGeometry, face_angles
+
+    scenario = default_scenario()
+    theta_r = np.linspace(0.5, 79.5, 12)
+    ti = np.radians(30.0)
+    n = len(theta_r)
+    normal = np.array([0.0, 0.0, 1.0])
+    sun = np.repeat(np.array([np.sin(ti), 0.0, np.cos(ti)])[:, None], n, axis=1)
+    view = np.stack([-np.sin(np.radians(theta_r)), np.zeros(n), np.cos(np.radians(theta_r))])  # dphi = 180
+    position = np.repeat(np.array([7000.0, 0.0, 0.0])[:, None], n, axis=1)
+    face = Face("plate", 1.0, "inertial", tuple(normal))
+    a_i, a_r, dphi = face_angles(np.repeat(normal[:, None], n, axis=1), sun, view)
+    assert np.allclose(a_i, 30.0) and np.allclose(a_r, theta_r) and np.allclose(np.abs(dphi), 180.0)
+    times = [datetime(2014, 1, 21, tzinfo=timezone.utc)] * n
+    geometry = PassGeometry("plate", (0.0, 0.0, 0.0), times, np.zeros(n), np.full(n, 45.0), np.full(n, 1000.0),
+                            np.zeros(n), np.full(n, 30.0), np.ones(n, bool), np.degrees(np.arccos(np.sum(sun * view, axis=0))),
+                            position, np.repeat(np.array([[0.0], [7.5], [0.0]]), n, axis=1), sun, view, [face],
+                            a_i[:, None], a_r[:, None], dphi[:, None])
+    model = Model.from_string("specular+shadowing+body")
+    draws = {"n": np.array([1.4, 1.5, 1.7]), "k": np.array([0.0, 0.1, 0.5]), "sigma": np.array([0.2, 0.25, 0.35]),
+             "ks": np.array([0.6, 0.5, 0.9]), "rho_d": np.array([0.3, 0.1, 0.05])}
+    light = target_light(geometry, model, draws, BAND)
+    scenario.target.update(theta_r_low_deg=float(theta_r[0]), theta_r_high_deg=float(theta_r[-1]))
+    grid_theta_r, dop = target_dop_grid(model, draws, scenario)
+    expected = np.stack([np.interp(theta_r, grid_theta_r, row) for row in dop])
+    assert np.abs(light.dolp - expected).max() < 2e-3  # the contrast grid's linear interpolation in theta_r
+    exact = model.dop(draws, Geometry(np.full(n, 30.0), theta_r, np.full(n, 180.0)))
+    assert np.abs(light.dolp - exact).max() < 1e-9

@@ -103,21 +103,22 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
     n_times = len(geometry.times_utc)
     s_sky, _ = sky_basis(geometry)
     stokes = np.zeros((4, n_draws, n_times))
-    lit_faces = np.zeros(n_times, int)
-    for k, face in enumerate(geometry.faces):
-        on = geometry.lit[:, k] & geometry.seen[:, k]
-        if not on.any():
-            continue
-        lit_faces += on
-        rows = np.flatnonzero(on)
-        g = Geometry(geometry.theta_i_deg[rows, k], geometry.theta_r_deg[rows, k], geometry.dphi_deg[rows, k])
-        s = np.asarray(model.evaluate(params, g).stokes, float).reshape(4, -1, len(rows))  # (4, D or 1, rows) sr^-1
-        ti, tr = np.radians(geometry.theta_i_deg[rows, k]), np.radians(geometry.theta_r_deg[rows, k])
-        scale = irradiance * np.cos(ti) * face.area_m2 * np.cos(tr) / (geometry.range_km[rows] * 1e3) ** 2
-        psi = _rotation_to_sky(geometry.normals(k)[:, rows], geometry.to_observer_unit[:, rows], s_sky[:, rows])
+    on = geometry.lit & geometry.seen  # (T, faces)
+    lit_faces = on.sum(axis=1)
+    times, faces = np.nonzero(on)
+    if times.size:
+        # every (time, face) that sends light in one evaluation of the model
+        g = Geometry(geometry.theta_i_deg[times, faces], geometry.theta_r_deg[times, faces], geometry.dphi_deg[times, faces])
+        sr = np.asarray(model.evaluate(params, g).stokes, float).reshape(4, -1, times.size)  # (4, D or 1, rows) sr^-1
+        area = np.array([f.area_m2 for f in geometry.faces])[faces]
+        ti, tr = np.radians(geometry.theta_i_deg[times, faces]), np.radians(geometry.theta_r_deg[times, faces])
+        scale = irradiance * np.cos(ti) * area * np.cos(tr) / (geometry.range_km[times] * 1e3) ** 2
+        normals = np.stack([geometry.normals(k) for k in range(len(geometry.faces))], axis=-1)  # (3, T, faces)
+        psi = _rotation_to_sky(normals[:, times, faces], geometry.to_observer_unit[:, times], s_sky[:, times])
         c, sn = np.cos(2 * psi), np.sin(2 * psi)
-        rotated = np.stack([s[0], c * s[1] + sn * s[2], -sn * s[1] + c * s[2], s[3]])
-        stokes[:, :, rows] += rotated * scale
+        rotated = np.stack([sr[0], c * sr[1] + sn * sr[2], -sn * sr[1] + c * sr[2], sr[3]]) * scale
+        for component in range(4):  # faces seen at the same time add up
+            np.add.at(stokes[component], (slice(None), times), np.broadcast_to(rotated[component], (n_draws, times.size)))
     with np.errstate(invalid="ignore", divide="ignore"):
         lit = stokes[0] > 0
         dolp = np.where(lit, np.hypot(stokes[1], stokes[2]) / np.where(lit, stokes[0], 1.0), np.nan)

@@ -153,8 +153,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--picks", type=_int_at_least(1), default=3, help="measurements to propose (chosen greedily)")
     p.add_argument("--noise", action="append", default=[], metavar="OBS=X",
                    help="assumed noise of a new measurement of observable OBS, e.g. dop=0.005, brdf=0.03 (relative), "
-                        "mueller=0.01 (default: the data's own, else the observable's design noise: dop 0.01, "
-                        "brdf 5 %%, mueller 0.01, dolp 0.01, docp 0.01)")
+                        "mueller=0.01 (default: the data's own, else each observable's design noise; the candidates are "
+                        "the observables that declare one)")
     p.add_argument("--out", default="reports/design")
 
     p = sub.add_parser("batch", help="one inversion per row of a manifest, on a process pool or a Dask cluster")

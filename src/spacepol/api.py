@@ -416,9 +416,9 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     inner, params, material = material_samples(result.model, result.samples(), scenario,
                                                result.summary.get("spec", result.summary["model"]))
     rng = np.random.default_rng(seed)
-    size = len(next(iter(params.values())))
+    size = max(np.size(v) for v in params.values())
     pick = rng.choice(size, min(draws, size), replace=False)
-    chosen = {k: np.asarray(v)[pick] for k, v in params.items()}
+    chosen = {k: np.asarray(v)[pick] if np.size(v) == size else v for k, v in params.items()}  # fixed values as they are
     if progress:
         print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
               f"{result.summary['model']}", file=sys.stderr)

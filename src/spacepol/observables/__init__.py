@@ -25,6 +25,7 @@ class ObservableRegistry(PluginRegistry):
     def __init__(self):
         super().__init__()
         self._instances: dict[str, Observable] = {}
+        self._files: dict[str, str] = {}  # "path.py:Name" -> the observable it registered (a file is imported once)
 
     def check_class(self, cls: type[Observable]) -> None:
         """A name that is an identifier, at least one channel, and the file columns and Dataset arrays it reads."""
@@ -56,7 +57,9 @@ class ObservableRegistry(PluginRegistry):
         """The observable of that name or alias (``q``, ``u``), or of a file ``path/to/file.py:Name``; one clear
         error for an unknown one."""
         if ".py:" in name:
-            return self._instances[self.load_file(name).name]
+            if name not in self._files:
+                self._files[name] = self.load_file(name).name
+            return self._instances[self._files[name]]
         self.load_entry_points()
         for o in self.every():
             if name == o.name or name in o.aliases:

@@ -63,6 +63,9 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
     from test_contrast import _run_dir
 
     run = _run_dir(tmp_path, spread=1.0)
+    summary = json.loads((run / "summary.json").read_text())  # a run that held a parameter fixed, as most do
+    summary["fixed"] = {"sigma_p": Model.from_string(summary["model"]).parameter("sigma_p").default}
+    (run / "summary.json").write_text(json.dumps(summary))
     tle = bundled("tle", "iss_zarya_2014-01-20.tle")
     args = [sys.executable, "-m", "spacepol.cli", "observe", str(run), "--tle", str(tle), "--site", "43.1333,125.5333,200",
             "--start", "2014-01-21T00:33:00Z", "--end", "2014-01-21T00:39:00Z", "--step", "30", "--draws", "50"]

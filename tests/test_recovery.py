@@ -51,6 +51,21 @@ def data(tmp_path_factory):
 RUN = ("--model", "specular+smith", "--steps", "900", "--seed", "2")
 
 
+@pytest.fixture(scope="module")
+def finished(data, tmp_path_factory):
+    """A finished 300-step run, made once; tests damage copies of it."""
+    out = tmp_path_factory.mktemp("finished") / "run"
+    first = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
+    assert first.returncode == 0, first.stderr
+    return out
+
+
+def copy_of(run, tmp_path):
+    import shutil
+
+    return shutil.copytree(run, tmp_path / "run")
+
+
 def test_kill_during_sampling_and_during_the_report_then_the_same_command_completes(data, tmp_path):
     out = tmp_path / "run"
     proc = start("run", data, *RUN, "--out", out)
@@ -78,10 +93,8 @@ def test_kill_during_sampling_and_during_the_report_then_the_same_command_comple
     assert json.loads((out / "summary.json").read_text())["parameters"] == summary["parameters"]
 
 
-def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path):
-    out = tmp_path / "run"
-    first = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
-    assert first.returncode == 0, first.stderr
+def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, finished, tmp_path):
+    out = copy_of(finished, tmp_path)
     chain = out / "chain.h5"
     size = chain.stat().st_size
     with open(chain, "r+b") as fh:  # a kill during a write / a full disk: the file is cut short
@@ -102,7 +115,7 @@ def test_a_damaged_chain_gives_one_line_and_restart_starts_afresh(data, tmp_path
     assert empty.returncode == 2 and "empty file" in empty.stderr
 
 
-def test_a_chain_whose_random_state_a_kill_broke_continues(data, tmp_path):
+def test_a_chain_whose_random_state_a_kill_broke_continues(data, finished, tmp_path):
     """emcee rewrites its random state (a string attribute in HDF5's global heap) at every step; a kill there
     leaves it unreadable ("Expected global heap object size does not match") with every step intact. The
     same command continues from the stored steps with a state drawn from the run's generator; the steps
@@ -110,9 +123,7 @@ def test_a_chain_whose_random_state_a_kill_broke_continues(data, tmp_path):
     import h5py
     import numpy as np
 
-    out = tmp_path / "run"
-    first = cli("run", data, *RUN, "--steps", "300", "--quiet", "--out", out)
-    assert first.returncode == 0, first.stderr
+    out = copy_of(finished, tmp_path)
     chain = out / "chain.h5"
     with h5py.File(chain, "a") as f:  # what a reader sees after the kill: no readable random state
         for key in [k for k in f["mcmc"].attrs if k.startswith("random_state")]:

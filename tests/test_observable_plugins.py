@@ -61,6 +61,10 @@ def test_dolp_and_docp_are_registered_from_their_own_files_and_read_from_a_csv(t
                          "docp_err": np.full(g.size, 0.01)})
     with pytest.raises(SpacepolError, match="column 'docp_err' without 'docp'"):
         read_measurements(orphan)
+    lone = tmp_path / "lone_s3.csv"  # an observable's optional column alone is not silently dropped
+    write_table(lone, {"theta_i": g.theta_i, "theta_r": g.theta_r, "dop": np.full(g.size, 0.1), "s3": np.zeros(g.size)})
+    with pytest.raises(SpacepolError, match="column 's3' without 's0'"):
+        read_measurements(lone)
 
 
 def test_the_mueller_matrix_holds_dolp_and_docp_and_their_predictions_agree_with_it():

@@ -77,9 +77,9 @@ class Observable:
             missing = ", ".join(c for c in self.columns if c not in header)
             raise InputFileError(path, f"{self.title or self.name} data need all of {', '.join(self.columns)}; missing "
                                        f"{missing}", line=line)
-        errors = [c for c in self.error_columns if c in header]
-        if errors and not given:
-            raise InputFileError(path, f"column '{errors[0]}' without '{self.columns[0]}'", line=line)
+        extra = [c for c in self.error_columns + self.optional_columns if c in header]
+        if extra and not given:
+            raise InputFileError(path, f"column '{extra[0]}' without '{self.columns[0]}'", line=line)
 
     def check_value(self, column: str, value: float, path, line) -> None:
         """One cell of one of its columns (a negative error here; subclasses add their ranges)."""

@@ -69,13 +69,16 @@ class Camera:
         tile = np.array(self.layout.angles, float)
         return np.tile(tile, (shape[0] // 2, shape[1] // 2))
 
+    def passed(self, s0, s1, s2, theta_rad):
+        """What an analyser at ``theta_rad`` passes of light with linear Stokes parameters s0, s1, s2 (broadcast)."""
+        total, diff = self.transmissions
+        return 0.5 * (total * s0 + diff * (s1 * np.cos(2 * theta_rad) + s2 * np.sin(2 * theta_rad)))
+
     def expected_electrons(self, stokes_photons_s: np.ndarray) -> np.ndarray:
         """(H, W) mean electrons per pixel in one exposure from the Stokes photon rate (3, H, W) per pixel
         (photons s^-1 on the pixel before its analyser), dark current included."""
         s0, s1, s2 = stokes_photons_s
-        theta = np.radians(self.angle_map(s0.shape))
-        total, diff = self.transmissions
-        passed = 0.5 * (total * s0 + diff * (s1 * np.cos(2 * theta) + s2 * np.sin(2 * theta)))
+        passed = self.passed(s0, s1, s2, np.radians(self.angle_map(s0.shape)))
         return (self.quantum_efficiency * passed + self.dark_current_e_per_s) * self.exposure_s
 
     def expose(self, stokes_photons_s: np.ndarray, rng: np.random.Generator) -> np.ndarray:

@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
+from ..camera.mosaic import linear_stokes
+
 DETECTORS = ("intensity", "stokes", "dolp")
 
 
@@ -38,11 +40,16 @@ def neyman_pearson(deflection, p_false_alarm: float):
     return stats.norm.sf(stats.norm.isf(p_false_alarm) - np.asarray(deflection, float))
 
 
+def _per_pixel(variance, signal: np.ndarray) -> np.ndarray:
+    """The noise variance (4,) per channel or (4, H, W) per channel pixel, as (4, H, W)."""
+    return np.broadcast_to(np.asarray(variance, float).reshape(4, *([1] * (signal.ndim - 1))), signal.shape)
+
+
 def deflections(signal: np.ndarray, variance: np.ndarray) -> dict[str, float]:
     """{detector: d} of the intensity and Stokes matched filters for the target's electrons ``signal`` (4, H, W) per
     analyser channel and the noise ``variance`` (4,) or (4, H, W) per channel pixel."""
     signal = np.asarray(signal, float)
-    variance = np.broadcast_to(np.asarray(variance, float).reshape(4, *([1] * (signal.ndim - 1))), signal.shape)
+    variance = _per_pixel(variance, signal)
     total = signal.sum(axis=0)
     return {"intensity": float(np.sum(total**2 / variance.sum(axis=0)) ** 0.5),
             "stokes": float(np.sum(signal**2 / variance) ** 0.5)}
@@ -53,7 +60,7 @@ def matched_filter(frames: np.ndarray, background: np.ndarray, signal: np.ndarra
     """The whitened matched-filter statistic of each frame (N, 4, H, W) for the known ``signal`` (4, H, W) over the
     known ``background`` (4,) per channel pixel; normalised to unit variance, so the mean with the target is d."""
     frames = np.asarray(frames, float) - np.asarray(background, float).reshape(1, 4, 1, 1)
-    var = np.broadcast_to(np.asarray(variance, float).reshape(4, *([1] * (signal.ndim - 1))), signal.shape)
+    var = _per_pixel(variance, signal)
     if detector == "intensity":
         summed, s, v = frames.sum(axis=1), signal.sum(axis=0), var.sum(axis=0)
         return np.tensordot(summed, s / v, axes=([1, 2], [0, 1])) / np.sqrt(np.sum(s**2 / v))
@@ -66,8 +73,7 @@ def dolp_statistic(frames: np.ndarray, background: np.ndarray, psf: np.ndarray) 
     """The DoLP of the PSF-weighted, background-subtracted flux of each frame (N, 4, H, W): a polarization detector
     that ignores the intensity (analysers 0, 45, 90, 135 deg in the channel order)."""
     flux = np.tensordot(np.asarray(frames, float) - np.asarray(background, float).reshape(1, 4, 1, 1), psf, axes=([2, 3], [0, 1]))
-    s0 = 0.5 * flux.sum(axis=1)
-    s1, s2 = flux[:, 0] - flux[:, 2], flux[:, 1] - flux[:, 3]
+    s0, s1, s2 = linear_stokes(dict(zip((0.0, 45.0, 90.0, 135.0), flux.T)))
     return np.hypot(s1, s2) / np.maximum(np.abs(s0), 1e-300)
 
 

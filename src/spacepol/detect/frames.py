@@ -21,7 +21,7 @@ def simulate_frame(observation, time_index: int, draw_index: int, rng: np.random
     p_sky = observation.sky_dolp[time_index]
     # the sky's Stokes photon rate per pixel before the analysers, uniform
     field = np.stack([np.full((2 * n, 2 * n), v) for v in (sky, sky * p_sky * np.cos(2 * sky_aop), sky * p_sky * np.sin(2 * sky_aop))])
-    s = observation.light.stokes_w_m2[:, draw_index, time_index] * observation.photons_per_watt
+    s = observation.light.stokes_w_m2[:, draw_index, time_index] * observation.light.photons_per_joule
     if np.all(np.isfinite(s)) and s[0] > 0:
         psf = gaussian_psf(2 * n, camera.psf_fwhm_pixels)  # on the pixel grid, sum 1
         # photons s^-1 on the pixels before the analysers: the flux times the collecting area and transmittance

@@ -19,14 +19,13 @@ the horizon and the sky's turbidity are not modelled further.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .detection import deflections, gaussian_psf, neyman_pearson
 from .radiometry import background_photon_flux
-from .target import sky_basis, solar_band, target_light
+from .target import bands_over_draws, sky_basis, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
@@ -61,18 +60,11 @@ class Observation:
     p_false_alarm: float
     camera: object
     sky_aop_deg: np.ndarray | None = None  # (T,) the sky's AoP in the target's sky basis
-    photons_per_watt: float = 0.0  # the band's photons per joule: Stokes W m^-2 -> photons m^-2 s^-1
 
     def to_json(self) -> dict:
         """``observe.json``'s content (DESIGN.md's fields, units in the key names)."""
-        def band(values):
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # a time with no light in any draw: NaN, said so
-                q = np.nanpercentile(values, [5, 50, 95], axis=0)
-            return q
-
-        flux, dolp, aop = band(self.light.photons_m2_s), band(self.light.dolp), band(self.light.aop_deg)
-        pd = {k: band(v) for k, v in self.p_detect.items()}
+        flux, dolp, aop = (bands_over_draws(v) for v in (self.light.photons_m2_s, self.light.dolp, self.light.aop_deg))
+        pd = {k: bands_over_draws(v) for k, v in self.p_detect.items()}
         g = self.geometry
         rows = []
         for j, t in enumerate(g.times_utc):
@@ -110,19 +102,17 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
     sky_photons = sky_photons_at(geometry, sky_magnitude_zenith)
     sun = (90.0 - geometry.sun_elevation_deg, geometry.sun_azimuth_deg)
     sky = RayleighSky(p_max)
-    sky_dolp = np.array([float(sky.dop(view_zenith[j], geometry.azimuth_deg[j], (sun[0][j], sun[1][j])))
-                         for j in range(len(view_zenith))])
+    sky_dolp = np.asarray(sky.dop(view_zenith, geometry.azimuth_deg, sun), float)
     sky_aop = _sky_aop(geometry)
     collect = camera.quantum_efficiency * camera.transmittance * camera.aperture_area_m2 * camera.exposure_s
     total, diff = camera.transmissions
     angles = np.radians(np.array(camera.layout.order))
+    sky_psi = np.radians(sky_aop)
     # the PSF on the superpixel grid (one superpixel = 2 pixels on a side)
     psf = gaussian_psf(stamp_superpixels, camera.psf_fwhm_pixels / 2.0)
     pixel_arcsec2 = camera.pixel_scale_arcsec**2
     n_draws, n_times = light.photons_m2_s.shape
     out_d = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
-    irradiance, photons = solar_band(*band_um)
-    per_watt = photons / irradiance  # the band's photons per joule
     for j in range(n_times):
         if geometry.elevation_deg[j] <= 0:
             continue
@@ -130,22 +120,24 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
         if np.max(0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j])) > camera.full_well_e:
             out_d["intensity"][:, j] = out_d["stokes"][:, j] = 0.0  # the sky alone fills the wells
             continue
-        b = 0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j] * np.cos(2 * (angles - np.radians(sky_aop[j]))))
+        sky = sky_photons[j] * pixel_arcsec2
+        b = collect * camera.passed(sky, sky * sky_dolp[j] * np.cos(2 * sky_psi[j]), sky * sky_dolp[j] * np.sin(2 * sky_psi[j]),
+                                    angles)
         variance = b + camera.dark_current_e_per_s * camera.exposure_s + camera.read_noise_e**2
         for i in range(n_draws):
-            s = light.stokes_w_m2[:, i, j] * per_watt  # photons m^-2 s^-1 per Stokes component
+            s = light.stokes_w_m2[:, i, j] * light.photons_per_joule  # photons m^-2 s^-1 per Stokes component
             if not np.all(np.isfinite(s)) or s[0] <= 0:
                 out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0
                 continue
             # a quarter of the target's light falls on each channel's pixels, which pass their analyser's share
-            electrons = 0.25 * 0.5 * collect * (total * s[0] + diff * (s[1] * np.cos(2 * angles) + s[2] * np.sin(2 * angles)))
+            electrons = 0.25 * collect * camera.passed(s[0], s[1], s[2], angles)
             if np.max(electrons[:, None, None] * psf * 4 + b[:, None, None]) > camera.full_well_e:
                 out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0  # saturated: the filters see a flat top
                 continue
             d = deflections(electrons[:, None, None] * psf, variance)
             out_d["intensity"][i, j], out_d["stokes"][i, j] = d["intensity"], d["stokes"]
     p_detect = {k: np.where(np.isfinite(v), neyman_pearson(np.nan_to_num(v), p_false_alarm), np.nan) for k, v in out_d.items()}
-    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera, sky_aop, per_watt)
+    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera, sky_aop)
 
 
 def sky_photons_at(geometry, sky_magnitude_zenith: float = 5.40) -> np.ndarray:

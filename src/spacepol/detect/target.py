@@ -51,22 +51,22 @@ def solar_band(band_low_um: float, band_high_um: float, temperature_k: float = S
 class TargetLight:
     """The target's light at the aperture over a pass, for D material draws at T times: ``stokes_w_m2`` (4, D, T) in
     the sky basis (S1 > 0 horizontal), ``photons_m2_s`` (D, T) (S0 in photons), ``dolp`` and ``aop_deg`` (D, T;
-    NaN where no light comes), ``lit_faces`` (T,) how many faces send light."""
+    NaN where no light comes), ``lit_faces`` (T,) how many faces send light, ``photons_per_joule`` the band's photons
+    per joule of sunlight (Stokes W m^-2 -> photons m^-2 s^-1)."""
 
     stokes_w_m2: np.ndarray
     photons_m2_s: np.ndarray
     dolp: np.ndarray
     aop_deg: np.ndarray
     lit_faces: np.ndarray
+    photons_per_joule: float
 
-    def band(self, quantity: str) -> dict:
-        """{"median", "q05", "q95"} over the draws at each time (lists of length T) of ``photons_m2_s``, ``dolp`` or
-        ``aop_deg``."""
-        values = getattr(self, quantity)
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # a time with no light in any draw: NaN, said so
-            q = np.nanpercentile(values, [5, 50, 95], axis=0)
-        return {"median": q[1].tolist(), "q05": q[0].tolist(), "q95": q[2].tolist()}
+
+def bands_over_draws(values: np.ndarray) -> np.ndarray:
+    """(3, T) the 5 %, 50 % and 95 % quantiles over the draws (axis 0) at each time, NaN where no draw has a value."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a time with no light in any draw: NaN, said so
+        return np.nanpercentile(values, [5, 50, 95], axis=0)
 
 
 def sky_basis(geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -123,4 +123,4 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         lit = stokes[0] > 0
         dolp = np.where(lit, np.hypot(stokes[1], stokes[2]) / np.where(lit, stokes[0], 1.0), np.nan)
         aop = np.where(lit, 0.5 * np.degrees(np.arctan2(stokes[2], stokes[1])), np.nan)
-    return TargetLight(stokes, stokes[0] * photons / irradiance, dolp, aop, lit_faces)
+    return TargetLight(stokes, stokes[0] * photons / irradiance, dolp, aop, lit_faces, photons / irradiance)

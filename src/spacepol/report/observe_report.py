@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..detect.target import bands_over_draws
 from ..io.atomic import atomic_path, save_figure, write_json
 from . import html as H
 
@@ -22,12 +23,7 @@ def light_curves_figure(observation, fig=None) -> Figure:
     light = observation.light
 
     def band(ax, values, colour, label):
-        with np.errstate(all="ignore"):
-            import warnings
-
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)
-                lo, med, hi = np.nanpercentile(values, [5, 50, 95], axis=0)
+        lo, med, hi = bands_over_draws(values)
         ax.fill_between(minutes, lo, hi, color=colour, alpha=0.3, lw=0)
         ax.plot(minutes, med, "-", color=colour, label=label)
 

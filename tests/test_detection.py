@@ -82,3 +82,38 @@ def test_the_dolp_detectors_threshold_from_sky_frames_holds_its_false_alarm_rate
     assert 0.45 * P_FA < rate < 1.55 * P_FA, rate
     with pytest.raises(ValueError, match="set no threshold"):
         threshold_from_sky(sky[:5000], P_FA)
+
+
+def channel_fluxes(totals, background, variance, psf, stacked):
+    """The PSF-weighted channel fluxes' sky mean, mean with the target and SD for this stamp of superpixels: the
+    target's ``totals`` (4,) electrons per channel spread by ``psf`` over the channel's pixels."""
+    w1, w2 = psf.sum(), np.sum(psf**2)
+    return background * w1, (background * w1 + totals * w2)[None, :], np.sqrt(variance * w2 / stacked)
+
+
+def test_the_dolp_detectors_pd_from_channel_fluxes_equals_full_frames_and_stacking():
+    """Over a pass the DoLP detector's P_d comes from the four PSF-weighted channel fluxes drawn directly
+    (``dolp_detection_probability``). Full Poisson frames with read noise, the threshold from 20,000 sky-only frames
+    and P_d from 4,000 with the target, give the same P_d within Monte-Carlo error, for one exposure and for four
+    averaged. The control: the one-exposure figure against the four averaged frames misses."""
+    from spacepol.detect.detection import dolp_detection_probability
+
+    rng = np.random.default_rng(5)
+    background, signal, variance, psf = scene(target_e=1.0)
+    totals = signal.sum(axis=(1, 2))  # (4,) electrons per channel for 1 e in all: the PSF sums to 1
+    measured, reduced = {}, {}
+    for stacked in (1, 4):
+        target_e = 900.0 / stacked**0.5  # P_d about one half
+        sky = np.concatenate([dolp_statistic(np.mean([frames(background, 0 * signal, 5000, rng) for _ in range(stacked)], axis=0),
+                                             background, psf) for _ in range(4)])
+        hits = np.mean([frames(background, target_e * signal, 4000, rng) for _ in range(stacked)], axis=0)
+        p_full, error_full = detection_probability(dolp_statistic(hits, background, psf), threshold_from_sky(sky, 1e-3))
+        p_fast = dolp_detection_probability(*channel_fluxes(target_e * totals, background, variance, psf, stacked), 1e-3, rng,
+                                            target_frames=20_000)[0]
+        measured[stacked], reduced[stacked] = (p_full, error_full), p_fast
+        # binomial errors of both P_d plus the two thresholds' quantile errors (about 0.02 each at P_d 1/2)
+        assert 0.2 < p_full < 0.9 and abs(p_fast - p_full) < 4 * np.hypot(error_full, 0.03), (stacked, p_full, p_fast)
+    single_against_stack = dolp_detection_probability(*channel_fluxes(900.0 / 2 * totals, background, variance, psf, 1),
+                                                      1e-3, rng, target_frames=20_000)[0]
+    p_full, error_full = measured[4]
+    assert abs(single_against_stack - p_full) > 4 * np.hypot(error_full, 0.03)

@@ -38,12 +38,14 @@ def test_observe_json_has_designs_fields_and_pd_is_the_false_alarm_rate_without_
     row = j["times"][0]
     assert {"time_utc", "range_km", "elevation_deg", "sun_elevation_deg", "phase_angle_deg", "sunlit", "target", "sky",
             "p_detect"} <= set(row)
-    assert set(row["target"]) == {"flux_photons_m2_s", "dolp", "aop_deg"} and set(row["p_detect"]) == {"intensity", "stokes"}
+    assert set(row["target"]) == {"flux", "dolp", "aop_deg"} and set(row["p_detect"]) == {"intensity", "stokes", "dolp"}
     dark = observation.light.lit_faces == 0
     assert dark.any() and (~dark).any()
     for detector, p in observation.p_detect.items():
         assert np.allclose(p[:, dark & (observation.geometry.elevation_deg > 0)], observation.p_false_alarm)
-        assert np.all((p[np.isfinite(p)] >= observation.p_false_alarm - 1e-12) & (p[np.isfinite(p)] <= 1.0))
+        # the matched filters' P_d never fall below P_fa; the DoLP image's is a Monte-Carlo figure (2,000 frames)
+        low = observation.p_false_alarm - (1e-12 if detector != "dolp" else 4 * np.sqrt(observation.p_false_alarm / 2000))
+        assert np.all((p[np.isfinite(p)] >= low) & (p[np.isfinite(p)] <= 1.0)), detector
 
 
 def test_the_stokes_detector_is_never_below_intensity(observation):

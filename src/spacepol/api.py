@@ -378,14 +378,16 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
 
 def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, satellite: str | None = None, target=None,
             camera=None, draws: int = 200, seed: int = 0, p_false_alarm: float = 1e-3, band_um=(1.5, 1.8), out=None,
-            progress: bool = False):
+            progress: bool = False, exposures_per_step: int = 1):
     """A pass of the satellite of ``tle`` (a TLE file; ``satellite`` picks one of several) over ``site`` ((lat_deg,
     lon_deg[, height_m]) or "LAT,LON[,HEIGHT_M]") from ``start`` to ``end`` (ISO 8601 with offset) every ``step_s``
     seconds, its faces (``target``: a TOML file of [[faces]] or a list of ``orbit.Face``; default a 1 m cube with a
     4 m^2 sun-tracking panel) made of the Result's material (``draws`` posterior draws, n and k at the band's centre
     for a run over several wavelengths), seen by ``camera`` (a TOML file's [camera], a ``camera.sensor.Camera``, or
-    the default). Returns the ``detect.observation.Observation``: P_d(t) per detector at ``p_false_alarm``, light
-    curves with their posterior bands; with ``out`` observe.json, light_curves.png and report.html."""
+    the default), ``exposures_per_step`` exposures averaged at each time. Returns the ``detect.observation.Observation``:
+    P_d(t) per detector (intensity and Stokes matched filters, the DoLP image) at ``p_false_alarm``, P_d over the
+    whole pass, light curves with their posterior bands; with ``out`` observe.json, light_curves.png and
+    report.html."""
     from .camera.sensor import Camera, camera_from_toml
     from .detect.contrast import material_samples
     from .detect.observation import observe_pass
@@ -399,6 +401,8 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     site = _site(site)
     if not (isinstance(draws, int) and draws >= 1):
         raise ParameterError(f"--draws {draws}: need a whole number of at least 1")
+    if not (isinstance(exposures_per_step, int) and exposures_per_step >= 1):
+        raise ParameterError(f"--exposures {exposures_per_step}: need a whole number of at least 1")
     if not 0 < p_false_alarm < 0.5:
         raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
     faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
@@ -422,7 +426,7 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     if progress:
         print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
               f"{result.summary['model']}", file=sys.stderr)
-    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm)
+    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm, rng=rng, stacked=exposures_per_step)
     if out is not None:
         from .report.observe_report import write_observe_report
 
@@ -438,8 +442,10 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
             f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s (set where not given: the brightest sky of the "
             f"pass at half the full well), {camera.pixel_scale_arcsec:g} arcsec pixels, "
             f"PSF FWHM {camera.psf_fwhm_pixels:g} px, aperture {camera.aperture_area_m2:g} m^2.",
-            f"Detectors: intensity and Stokes (four analyser channels) matched filters; P_d from their Neyman-Pearson curves "
-            f"at P_fa = {p_false_alarm:g} (checked by simulation in the tests).",
+            f"Detectors: intensity and Stokes (four analyser channels) matched filters, P_d from their Neyman-Pearson curves "
+            f"at P_fa = {p_false_alarm:g} (checked by simulation in the tests); the DoLP image (|DoLP - the sky's DoLP| of "
+            f"the PSF-weighted flux), threshold and P_d by simulation ({observation.dolp_frames} frames per draw and time). "
+            f"{exposures_per_step} exposure(s) averaged per time; P_d over the pass assumes independent frames.",
         ]
         write_observe_report(observation, out, assumptions)
     return observation

@@ -200,6 +200,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--target", default=None, metavar="FILE.toml", help="[[faces]] (default: a 1 m cube and a 4 m^2 panel)")
     p.add_argument("--camera", default=None, metavar="FILE.toml", help="[camera] (default: an IMX250MZR-class sensor)")
     p.add_argument("--draws", type=_int_at_least(1), default=200, help="posterior draws of the material")
+    p.add_argument("--exposures", type=_int_at_least(1), default=1, metavar="N", help="exposures averaged per time step")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/observe")
     for p in sub.choices.values():  # --effect also after the command name, where users put it

@@ -374,11 +374,14 @@ def observe(args) -> int:
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "observe")
     observation = observe_pass(Result.load(args.run_dir), args.tle, args.site, args.start, args.end, step_s=args.step,
                                satellite=args.satellite, target=args.target, camera=args.camera, draws=args.draws,
-                               seed=args.seed, out=out, progress=True)
-    rows = observation.to_json()["times"]
+                               seed=args.seed, out=out, progress=True, exposures_per_step=args.exposures)
+    content = observation.to_json()
+    rows = content["times"]
     for name in observation.p_detect:
         best = max(rows, key=lambda r: r["p_detect"][name]["median"] or 0.0)
         print(f"{name}: best P_d {best['p_detect'][name]['median']:.3f} at {best['time_utc']} "
-              f"(elevation {best['elevation_deg']:.1f} deg, phase {best['phase_angle_deg']:.1f} deg)")
+              f"(elevation {best['elevation_deg']:.1f} deg, phase {best['phase_angle_deg']:.1f} deg); over the pass "
+              f"{content['over_pass']['p_detect'][name]['median']:.3f}")
+    print(f"over the pass a target-free sky gives a false alarm with probability {content['over_pass']['p_false_alarm']:.3f}")
     print(f"wrote {out}/observe.json, light_curves.png, report.html")
     return 0

@@ -10,8 +10,12 @@ Neyman-Pearson curve is P_d = Q(Q^-1(P_fa) - d) with d the deflection (the SNR o
 - ``stokes``: the filter on every channel with its own noise (the four analysers jointly, i.e. the Stokes images):
   d^2 = sum_c sum_x s_c(x)^2 / v_c. It gains where the sky is polarized (one analyser sees less of it) and the
   target's polarization differs from the sky's;
-- ``dolp``: the degree of linear polarization of the background-subtracted flux at the target, whose threshold comes
-  from sky-only frames (no closed form): ``empirical_threshold`` and ``detection_probability`` measure it.
+- ``dolp``: what a DoLP image shows: how far the degree of linear polarization of the PSF-weighted flux at the target
+  (sky and target together) lies from the sky's own DoLP. A target polarized unlike the sky, or a bright unpolarized
+  one diluting it, moves it. No closed form: its threshold comes from sky-only statistics and its P_d from frames
+  with the target (``dolp_statistic``, ``threshold_from_sky``, ``detection_probability``); over a pass,
+  ``dolp_detection_probability`` draws the four PSF-weighted channel fluxes directly, which for Gaussian pixel
+  noise have exactly the distribution full frames give them.
 
 ``threshold_from_sky`` sets any detector's threshold from statistics on sky-only frames.
 """
@@ -21,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
-from ..camera.mosaic import linear_stokes
+from ..camera.mosaic import dolp, linear_stokes
 
 DETECTORS = ("intensity", "stokes", "dolp")
 
@@ -70,11 +74,35 @@ def matched_filter(frames: np.ndarray, background: np.ndarray, signal: np.ndarra
 
 
 def dolp_statistic(frames: np.ndarray, background: np.ndarray, psf: np.ndarray) -> np.ndarray:
-    """The DoLP of the PSF-weighted, background-subtracted flux of each frame (N, 4, H, W): a polarization detector
-    that ignores the intensity (analysers 0, 45, 90, 135 deg in the channel order)."""
-    flux = np.tensordot(np.asarray(frames, float) - np.asarray(background, float).reshape(1, 4, 1, 1), psf, axes=([2, 3], [0, 1]))
-    s0, s1, s2 = linear_stokes(dict(zip((0.0, 45.0, 90.0, 135.0), flux.T)))
-    return np.hypot(s1, s2) / np.maximum(np.abs(s0), 1e-300)
+    """|DoLP - the sky's DoLP| of the PSF-weighted flux of each frame (N, 4, H, W) over a sky of ``background`` (4,)
+    electrons per channel pixel (analysers 0, 45, 90, 135 deg in the channel order): the DoLP image's detector."""
+    flux = np.tensordot(np.asarray(frames, float), psf, axes=([2, 3], [0, 1]))
+    return dolp_contrast(flux, np.asarray(background, float) * psf.sum())
+
+
+def _dolp(flux: np.ndarray) -> np.ndarray:
+    return dolp(linear_stokes(dict(zip((0.0, 45.0, 90.0, 135.0), np.moveaxis(np.asarray(flux, float), -1, 0)))))
+
+
+def dolp_contrast(flux: np.ndarray, sky_flux: np.ndarray) -> np.ndarray:
+    """|DoLP(flux) - DoLP(sky_flux)| of channel fluxes (..., 4) against the sky's own (4,)."""
+    return np.abs(_dolp(flux) - _dolp(sky_flux))
+
+
+def dolp_detection_probability(sky_flux: np.ndarray, target_flux: np.ndarray, flux_sd: np.ndarray, p_false_alarm: float,
+                               rng: np.random.Generator, sky_frames: int | None = None, target_frames: int = 2000) -> np.ndarray:
+    """(D,) P_d of the DoLP detector from its PSF-weighted channel fluxes F_c (analysers 0, 45, 90, 135 deg): their
+    means on the sky alone ``sky_flux`` (4,) and with each target ``target_flux`` (D, 4), and their noise SD
+    ``flux_sd`` (4,). With Gaussian pixel noise the F_c are Gaussian, so they are drawn directly: ``sky_frames``
+    sky-only ones (default 20 / P_fa) set the threshold, ``target_frames`` per target give its P_d (binomial error
+    at most 0.5 / sqrt(target_frames))."""
+    sky_flux, flux_sd = np.asarray(sky_flux, float), np.asarray(flux_sd, float)
+    target_flux = np.atleast_2d(np.asarray(target_flux, float))
+    sky_frames = int(np.ceil(20 / p_false_alarm)) if sky_frames is None else sky_frames
+    sky = dolp_contrast(sky_flux + flux_sd * rng.standard_normal((sky_frames, 4)), sky_flux)
+    threshold = threshold_from_sky(sky, p_false_alarm)
+    frames = target_flux[:, None, :] + flux_sd * rng.standard_normal((len(target_flux), target_frames, 4))
+    return np.mean(dolp_contrast(frames, sky_flux) > threshold, axis=1)
 
 
 def threshold_from_sky(sky_statistics: np.ndarray, p_false_alarm: float) -> float:

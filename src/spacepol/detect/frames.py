@@ -11,23 +11,30 @@ from ..camera.mosaic import stokes_maps
 from .detection import gaussian_psf
 
 
-def simulate_frame(observation, time_index: int, draw_index: int, rng: np.random.Generator, superpixels: int = 24):
-    """(raw counts (2 n, 2 n), Stokes maps) of one exposure at ``time_index`` with the material's draw ``draw_index``:
-    the target at the stamp's centre."""
+def frame_field(observation, time_index: int, draw_index: int | None, superpixels: int = 24) -> np.ndarray:
+    """(3, 2 n, 2 n) the Stokes photon rate (photons s^-1 per pixel, before the analysers) of the stamp around the
+    target at ``time_index``: the uniform sky plus, unless ``draw_index`` is None, the target of that material draw
+    through the PSF at the stamp's centre."""
     camera, n = observation.camera, superpixels
     sky_aop = np.radians(observation.sky_aop_deg[time_index])
     area = camera.transmittance * camera.aperture_area_m2  # photons m^-2 s^-1 -> photons s^-1 through the telescope
     sky = observation.sky_photons_arcsec2[time_index] * camera.pixel_scale_arcsec**2 * area
     p_sky = observation.sky_dolp[time_index]
-    # the sky's Stokes photon rate per pixel before the analysers, uniform
     field = np.stack([np.full((2 * n, 2 * n), v) for v in (sky, sky * p_sky * np.cos(2 * sky_aop), sky * p_sky * np.sin(2 * sky_aop))])
+    if draw_index is None:
+        return field
     s = observation.light.stokes_w_m2[:, draw_index, time_index] * observation.light.photons_per_joule
     if np.all(np.isfinite(s)) and s[0] > 0:
         psf = gaussian_psf(2 * n, camera.psf_fwhm_pixels)  # on the pixel grid, sum 1
-        # photons s^-1 on the pixels before the analysers: the flux times the collecting area and transmittance
         field = field + np.stack([s[k] * psf for k in range(3)]) * area
-    raw = camera.expose(field, rng)
-    return raw, stokes_maps(raw, camera.layout)
+    return field
+
+
+def simulate_frame(observation, time_index: int, draw_index: int, rng: np.random.Generator, superpixels: int = 24):
+    """(raw counts (2 n, 2 n), Stokes maps) of one exposure at ``time_index`` with the material's draw ``draw_index``:
+    the target at the stamp's centre."""
+    raw = observation.camera.expose(frame_field(observation, time_index, draw_index, superpixels), rng)
+    return raw, stokes_maps(raw, observation.camera.layout)
 
 
 def montage_figure(observation, time_indices, rng: np.random.Generator, draw_index: int = 0, fig=None) -> Figure:

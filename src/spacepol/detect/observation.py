@@ -1,9 +1,10 @@
 """A pass observed with a micro-polarizer camera: P_d(t) per detector over the material's posterior.
 
 Per time: the target's Stokes flux at the aperture (``detect.target``: each draw of the material), the sky at the
-target's direction, and the camera turn into electrons per analyser channel on the superpixel grid (the target
-through the PSF, the sky per pixel), and the matched filters' deflections into P_d at the fixed false-alarm rate
-(``detect.detection``: their Neyman-Pearson curves, checked by simulation in tests/test_detection.py).
+target's direction, and the camera turn into mean electrons per pixel of the raw mosaic (``detect.point_source``:
+the target through the PSF at places spread over a superpixel, the sky per pixel), and those into each detector's
+P_d at the fixed false-alarm rate (``detect.detection``: the matched filters' Neyman-Pearson curves, the DoLP
+image's by simulation; checked against simulated frames in tests/test_detection.py and tests/test_observation.py).
 
 The sky (stated model, the scenario may override its parts):
 - radiance: the CIE standard general sky, type 12 ("clear, low turbidity"; CIE S 011/E:2003, Kittler, Perez and
@@ -23,13 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .detection import deflections, gaussian_psf, neyman_pearson
+from .detection import dolp_detection_probability, neyman_pearson
+from .point_source import point_source_stamp, superpixel_positions
 from .radiometry import background_photon_flux
 from .target import bands_over_draws, sky_basis, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
-DETECTORS = ("intensity", "stokes")
+DETECTORS = ("intensity", "stokes", "dolp")
 
 
 def cie_relative_radiance(view_zenith_deg, scattering_deg, sun_zenith_deg, sky=CIE_CLEAR):
@@ -60,6 +62,15 @@ class Observation:
     p_false_alarm: float
     camera: object
     sky_aop_deg: np.ndarray | None = None  # (T,) the sky's AoP in the target's sky basis
+    stacked: int = 1  # exposures averaged per time step
+    dolp_frames: int = 2000  # simulated frames per draw and time behind the DoLP detector's P_d
+
+    def p_detect_over_pass(self) -> dict:
+        """{detector: (D,)} the probability of at least one detection over the times the target is above the
+        horizon, per draw (independent frames), and under "false_alarm" the same for a target-free sky."""
+        above = self.geometry.elevation_deg > 0
+        out = {k: 1.0 - np.prod(1.0 - np.nan_to_num(v[:, above]), axis=1) for k, v in self.p_detect.items()}
+        return out | {"false_alarm": 1.0 - (1.0 - self.p_false_alarm) ** int(above.sum())}
 
     def to_json(self) -> dict:
         """``observe.json``'s content (DESIGN.md's fields, units in the key names)."""
@@ -75,16 +86,24 @@ class Observation:
                          "elevation_deg": float(g.elevation_deg[j]), "azimuth_deg": float(g.azimuth_deg[j]),
                          "sun_elevation_deg": float(g.sun_elevation_deg[j]), "phase_angle_deg": float(g.phase_angle_deg[j]),
                          "sunlit": bool(g.sunlit[j]), "sky_state": g.sky[j],
-                         "target": {"flux_photons_m2_s": q(flux), "dolp": q(dolp), "aop_deg": q(aop)},
-                         "sky": {"radiance_photons_m2_s_arcsec2": float(self.sky_photons_arcsec2[j]),
+                         "target": {"flux": q(flux), "dolp": q(dolp), "aop_deg": q(aop)},
+                         "sky": {"radiance": float(self.sky_photons_arcsec2[j]),
                                  "dolp": float(self.sky_dolp[j])},
                          "p_detect": {k: q(v) for k, v in pd.items()}})
+        over_pass = self.p_detect_over_pass()
+        false_alarm = over_pass.pop("false_alarm")
         lat, lon, height = g.site
         return {"satellite": g.satellite, "site": {"lat_deg": lat, "lon_deg": lon, "height_m": height},
                 "window": {"start_utc": rows[0]["time_utc"], "end_utc": rows[-1]["time_utc"], "steps": len(rows)},
                 "camera": {k: v for k, v in vars(self.camera).items() if k not in ("layout", "exposure_set")}
                 | {"layout": self.camera.layout.name},
-                "detectors": list(self.p_detect), "times": rows, "p_false_alarm": self.p_false_alarm}
+                "detectors": list(self.p_detect), "times": rows, "p_false_alarm": self.p_false_alarm,
+                "exposures_per_step": self.stacked, "dolp_frames_per_draw": self.dolp_frames,
+                "units": {"flux": "photons m^-2 s^-1 at the aperture, in the band", "radiance": "photons m^-2 s^-1 arcsec^-2",
+                          "aop_deg": "deg in the sky basis, from the horizontal"},
+                "over_pass": {"steps_above_horizon": int(np.sum(g.elevation_deg > 0)), "p_false_alarm": false_alarm,
+                              "p_detect": {k: dict(zip(("q05", "median", "q95"), (_num(x) for x in np.nanpercentile(v, [5, 50, 95]))))
+                                           for k, v in over_pass.items()}}}
 
 
 def _num(x) -> float | None:
@@ -92,52 +111,64 @@ def _num(x) -> float | None:
 
 
 def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_false_alarm: float = 1e-3,
-                 sky_magnitude_zenith: float = 5.40, p_max: float = 0.7, stamp_superpixels: int = 9) -> Observation:
+                 sky_magnitude_zenith: float = 5.40, p_max: float = 0.7, stamp_pixels: int = 18,
+                 rng: np.random.Generator | None = None, stacked: int = 1, dolp_frames: int = 2000,
+                 positions_per_side: int = 4) -> Observation:
     """P_d over the pass ``geometry`` (with the target's faces) for the material ``model`` at ``draws`` seen by
-    ``camera`` (``camera.sensor.Camera``)."""
-    from ..skylight.rayleigh import RayleighSky
-
+    ``camera`` (``camera.sensor.Camera``), each time step ``stacked`` exposures averaged. Each detector's P_d is
+    the mean over ``positions_per_side``^2 places of the target within a superpixel (``detect.point_source``): the
+    matched filters' from their Neyman-Pearson curves, the DoLP image's by simulation (``rng``; ``dolp_frames``
+    frames per draw and time, so a binomial error of at most 0.5 / sqrt(dolp_frames)). ``deflection`` holds the
+    matched filters' deflections averaged over the places."""
+    rng = np.random.default_rng(0) if rng is None else rng
     light = target_light(geometry, model, draws, band_um)
-    view_zenith = 90.0 - geometry.elevation_deg
     sky_photons = sky_photons_at(geometry, sky_magnitude_zenith)
-    sun = (90.0 - geometry.sun_elevation_deg, geometry.sun_azimuth_deg)
-    sky = RayleighSky(p_max)
-    sky_dolp = np.asarray(sky.dop(view_zenith, geometry.azimuth_deg, sun), float)
+    sky_dolp = sky_dolp_at(geometry, p_max)
     sky_aop = _sky_aop(geometry)
-    collect = camera.quantum_efficiency * camera.transmittance * camera.aperture_area_m2 * camera.exposure_s
-    total, diff = camera.transmissions
-    angles = np.radians(np.array(camera.layout.order))
-    sky_psi = np.radians(sky_aop)
-    # the PSF on the superpixel grid (one superpixel = 2 pixels on a side)
-    psf = gaussian_psf(stamp_superpixels, camera.psf_fwhm_pixels / 2.0)
-    pixel_arcsec2 = camera.pixel_scale_arcsec**2
+    positions = superpixel_positions(stamp_pixels, positions_per_side)
+    per_place = max(dolp_frames // len(positions), 1)
+    pixel_area = camera.pixel_scale_arcsec**2 * camera.transmittance * camera.aperture_area_m2  # arcsec^2 m^2 per pixel
     n_draws, n_times = light.photons_m2_s.shape
-    out_d = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
+    deflection = {k: np.full((n_draws, n_times), np.nan) for k in ("intensity", "stokes")}
+    p_detect = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
     for j in range(n_times):
         if geometry.elevation_deg[j] <= 0:
             continue
-        # electrons on one pixel of each channel: the sky through its analyser
-        if np.max(0.5 * collect * sky_photons[j] * pixel_arcsec2 * (total + diff * sky_dolp[j])) > camera.full_well_e:
-            out_d["intensity"][:, j] = out_d["stokes"][:, j] = 0.0  # the sky alone fills the wells
-            continue
-        sky = sky_photons[j] * pixel_arcsec2
-        b = collect * camera.passed(sky, sky * sky_dolp[j] * np.cos(2 * sky_psi[j]), sky * sky_dolp[j] * np.sin(2 * sky_psi[j]),
-                                    angles)
-        variance = b + camera.dark_current_e_per_s * camera.exposure_s + camera.read_noise_e**2
-        for i in range(n_draws):
-            s = light.stokes_w_m2[:, i, j] * light.photons_per_joule  # photons m^-2 s^-1 per Stokes component
-            if not np.all(np.isfinite(s)) or s[0] <= 0:
-                out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0
-                continue
-            # a quarter of the target's light falls on each channel's pixels, which pass their analyser's share
-            electrons = 0.25 * collect * camera.passed(s[0], s[1], s[2], angles)
-            if np.max(electrons[:, None, None] * psf * 4 + b[:, None, None]) > camera.full_well_e:
-                out_d["intensity"][i, j] = out_d["stokes"][i, j] = 0.0  # saturated: the filters see a flat top
-                continue
-            d = deflections(electrons[:, None, None] * psf, variance)
-            out_d["intensity"][i, j], out_d["stokes"][i, j] = d["intensity"], d["stokes"]
-    p_detect = {k: np.where(np.isfinite(v), neyman_pearson(np.nan_to_num(v), p_false_alarm), np.nan) for k, v in out_d.items()}
-    return Observation(geometry, light, sky_photons, sky_dolp, out_d, p_detect, p_false_alarm, camera, sky_aop)
+        psi = np.radians(sky_aop[j])
+        sky = sky_photons[j] * pixel_area * np.array([1.0, sky_dolp[j] * np.cos(2 * psi), sky_dolp[j] * np.sin(2 * psi)])
+        stokes = (light.stokes_w_m2[:3, :, j] * light.photons_per_joule).T  # (D, 3) photons m^-2 s^-1
+        lit = np.all(np.isfinite(stokes), axis=1) & (np.nan_to_num(stokes[:, 0]) > 0)
+        stokes = np.where(lit[:, None], stokes, 0.0)
+        for k in DETECTORS:
+            p_detect[k][:, j] = 0.0
+        deflection["intensity"][:, j] = deflection["stokes"][:, j] = 0.0
+        for centre in positions:
+            stamp = point_source_stamp(camera, sky, centre, stamp_pixels)
+            if np.max(stamp.sky_e) > camera.full_well_e:
+                seen = np.zeros(n_draws, bool)  # the sky alone fills the wells
+            else:
+                seen = lit & ~stamp.saturated(stokes)  # a saturated target: the filters see a flat top
+            d = stamp.deflections(stokes, stacked)
+            for k in ("intensity", "stokes"):
+                d_k = np.where(seen, d[k], 0.0)
+                deflection[k][:, j] += d_k / len(positions)
+                p_detect[k][:, j] += neyman_pearson(d_k, p_false_alarm) / len(positions)
+            p_dolp = np.full(n_draws, p_false_alarm)
+            if seen.any():
+                sky_flux, target_flux, sd = stamp.dolp_fluxes(stokes[seen], stacked)
+                p_dolp[seen] = dolp_detection_probability(sky_flux, target_flux, sd, p_false_alarm, rng,
+                                                          target_frames=per_place)
+            p_detect["dolp"][:, j] += p_dolp / len(positions)
+    return Observation(geometry, light, sky_photons, sky_dolp, deflection, p_detect, p_false_alarm, camera, sky_aop,
+                       stacked=stacked, dolp_frames=per_place * len(positions))
+
+
+def sky_dolp_at(geometry, p_max: float = 0.7) -> np.ndarray:
+    """(T,) the sky's DoLP at the target's direction: single Rayleigh scattering scaled by ``p_max``."""
+    from ..skylight.rayleigh import RayleighSky
+
+    sun = (90.0 - geometry.sun_elevation_deg, geometry.sun_azimuth_deg)
+    return np.asarray(RayleighSky(p_max).dop(90.0 - geometry.elevation_deg, geometry.azimuth_deg, sun), float)
 
 
 def sky_photons_at(geometry, sky_magnitude_zenith: float = 5.40) -> np.ndarray:

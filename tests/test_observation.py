@@ -84,3 +84,17 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
         failed = subprocess.run(argv + ["--out", str(tmp_path / "bad")], capture_output=True, text=True)
         assert failed.returncode == 2 and words in failed.stderr, failed.stderr
         assert len(failed.stderr.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()
+
+
+def test_the_demos_pass_writes_its_report_and_names_every_detector(tmp_path):
+    """``invert-mcmc demo``'s sixth step: a run's material on the bundled daytime pass."""
+    from test_contrast import _run_dir
+
+    from spacepol.report.demo import observe_demo_pass
+
+    observation, lines = observe_demo_pass(_run_dir(tmp_path, spread=1.0), tmp_path / "observe", 0)
+    assert {"intensity", "stokes", "dolp"} == set(observation.p_detect)
+    assert all(any(line.startswith(f"{d}: best median P_d") for line in lines) for d in observation.p_detect)
+    assert (tmp_path / "observe" / "report.html").exists() and (tmp_path / "observe" / "light_curves.png").exists()
+    over = observation.p_detect_over_pass()
+    assert over["stokes"].shape == (100,) and np.all(over["stokes"] >= over["false_alarm"] - 1e-12)

@@ -119,3 +119,36 @@ def test_the_chain_gives_contrasts_target_dop_at_table_3s_geometry():
     assert np.abs(light.dolp - expected).max() < 2e-3  # the contrast grid's linear interpolation in theta_r
     exact = model.dop(draws, Geometry(np.full(n, 30.0), theta_r, np.full(n, 180.0)))
     assert np.abs(light.dolp - exact).max() < 1e-9
+
+
+def test_the_chain_gives_contrasts_sky_dop_at_table_3s_directions():
+    """Table 3's sky: the pass chain's sky DoLP (``observation.sky_dolp_at``, from a pass geometry's view and sun) at
+    the paper's two directions, at the scenario's site and time, equals ``contrast``'s sky DOP for the same P_max
+    (its draws at P_max fixed), at both ends of the scenario's P_max range. The control: the sun's azimuth off by
+    the paper's erroneous value (ERRATA) changes it."""
+    from datetime import datetime
+
+    from spacepol.detect.contrast import _draw_sky
+    from spacepol.detect.observation import sky_dolp_at
+    from spacepol.detect.scenario import default_scenario
+    from spacepol.orbit.pass_geometry import PassGeometry
+    from spacepol.skylight.sun import sun_position
+
+    scenario = default_scenario()
+    site = scenario.site
+    sun = sun_position(site["lat_deg"], site["lon_deg"], site["time"])
+    cases = scenario.cases
+    n = len(cases)
+    zeros = np.zeros((3, n))
+    geometry = PassGeometry("Table 3", (site["lat_deg"], site["lon_deg"], 0.0), [datetime.fromisoformat(site["time"])] * n,
+                            np.array([c["azimuth_deg"] for c in cases]), np.array([90.0 - c["zenith_deg"] for c in cases]),
+                            np.full(n, 1000.0), np.full(n, sun.azimuth_deg), np.full(n, 90.0 - sun.zenith_deg),
+                            np.ones(n, bool), np.zeros(n), zeros, zeros, zeros, zeros)
+    rng = np.random.default_rng(0)
+    for p_max in (scenario.sky["p_max_low"], scenario.sky["p_max_high"]):
+        chain = sky_dolp_at(geometry, p_max)
+        expected = [float(_draw_sky(scenario, case, sun, rng, 3, p_max)[0]) for case in cases]
+        assert np.allclose(chain, expected, rtol=1e-12, atol=1e-12), (chain, expected)
+        assert np.all((chain > 0.05) & (chain < p_max))
+    geometry.sun_azimuth_deg = np.full(n, -(4 + 32 / 60))  # the paper's stated azimuth
+    assert np.abs(sky_dolp_at(geometry, p_max) - expected).max() > 0.01

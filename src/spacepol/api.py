@@ -388,11 +388,7 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     P_d(t) per detector (intensity and Stokes matched filters, the DoLP image) at ``p_false_alarm``, P_d over the
     whole pass, light curves with their posterior bands; with ``out`` observe.json, light_curves.png and
     report.html."""
-    from .camera.sensor import Camera, camera_from_toml
-    from .detect.contrast import material_samples
-    from .detect.observation import observe_pass
-    from .detect.scenario import default_scenario
-    from .orbit import default_faces, faces_from_toml, pass_geometry, read_tle
+    from .detect.observation import observe_result
 
     if out is not None:
         from .io.output import check_output_dir
@@ -405,48 +401,13 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
         raise ParameterError(f"--exposures {exposures_per_step}: need a whole number of at least 1")
     if not 0 < p_false_alarm < 0.5:
         raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
-    faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
-    camera = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
-    element_set = read_tle(tle, satellite)
-    geometry = pass_geometry(element_set, site, start, end, step_s, faces)
-    if not camera.exposure_set:  # no exposure given: the one that keeps the brightest sky of the pass at half the well
-        from dataclasses import replace
-
-        from .detect.observation import auto_exposure_s
-
-        camera = replace(camera, exposure_s=auto_exposure_s(camera, geometry), exposure_set=True)
-    scenario = default_scenario()
-    scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
-    inner, params, material = material_samples(result.model, result.samples(), scenario,
-                                               result.summary.get("spec", result.summary["model"]))
-    rng = np.random.default_rng(seed)
-    size = max(np.size(v) for v in params.values())
-    pick = rng.choice(size, min(draws, size), replace=False)
-    chosen = {k: np.asarray(v)[pick] if np.size(v) == size else v for k, v in params.items()}  # fixed values as they are
-    if progress:
-        print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
-              f"{result.summary['model']}", file=sys.stderr)
-    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm, rng=rng, stacked=exposures_per_step)
+    observation, assumptions = observe_result(result, tle, site, start, end, step_s=step_s, satellite=satellite,
+                                              target=target, camera=camera, draws=draws, rng=np.random.default_rng(seed),
+                                              p_false_alarm=p_false_alarm, band_um=band_um, progress=progress,
+                                              exposures_per_step=exposures_per_step)
     if out is not None:
         from .report.observe_report import write_observe_report
 
-        assumptions = [
-            f"Satellite {element_set.name} from {element_set.source} (SGP4, skyfield), site {site[0]:.4f}, {site[1]:.4f} deg, "
-            f"{site[2]:g} m; {len(geometry.times_utc)} times every {step_s:g} s.",
-            f"Target: {len(faces)} faces ({', '.join(f'{f.name} {f.area_m2:g} m^2 {f.orientation}' for f in faces)}); "
-            "shadows between faces and light reflected between them are left out.",
-            f"Material: {len(pick)} draws of the posterior of {result.summary['model']}; {material['rule']}.",
-            f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
-            "5.40 mag arcsec^-2 at the zenith (the paper's), Rayleigh polarization with P_max 0.7.",
-            f"Camera: {camera.layout.name}, extinction ratio {camera.extinction_ratio:g}, QE {camera.quantum_efficiency:g}, read "
-            f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s (set where not given: the brightest sky of the "
-            f"pass at half the full well), {camera.pixel_scale_arcsec:g} arcsec pixels, "
-            f"PSF FWHM {camera.psf_fwhm_pixels:g} px, aperture {camera.aperture_area_m2:g} m^2.",
-            f"Detectors: intensity and Stokes (four analyser channels) matched filters, P_d from their Neyman-Pearson curves "
-            f"at P_fa = {p_false_alarm:g} (checked by simulation in the tests); the DoLP image (|DoLP - the sky's DoLP| of "
-            f"the PSF-weighted flux), threshold and P_d by simulation ({observation.dolp_frames} frames per draw and time). "
-            f"{exposures_per_step} exposure(s) averaged per time; P_d over the pass assumes independent frames.",
-        ]
         write_observe_report(observation, out, assumptions)
     return observation
 

@@ -9,7 +9,9 @@
 4. The same on PTFE (``ptfe_diagnose/``, ``ptfe_ladder/``): which effects improve ELPD-LOO by
    more than 2 SE, and the error falling as they are added.
 5. The PTFE posterior against the daytime sky: Table 3 as distributions (``contrast/``).
-6. ``report.html`` links them and says what was found.
+6. A target of that material on a real daytime pass (the bundled ISS elements over the paper's site): light curves
+   and P_d(t) per detector (``observe/``).
+7. ``report.html`` links them and says what was found.
 """
 
 from __future__ import annotations
@@ -154,6 +156,35 @@ def _effect_parameters(name: str) -> list[str]:
     return [p.name for p in registry.get(name).parameters]
 
 
+DEMO_PASS = {"tle": ("tle", "iss_zarya_2014-01-20.tle"), "site": (43 + 8 / 60, 125 + 32 / 60, 200.0),
+             "start": "2014-01-21T00:33:00Z", "end": "2014-01-21T00:40:00Z", "step_s": 20.0}
+
+
+def observe_demo_pass(run_dir: Path, out: Path, seed: int) -> tuple:
+    """The run's material on the bundled daytime pass (DEMO_PASS): observe/ and what it found, in sentences."""
+    from ..detect.observation import observe_result
+    from ..infer.result import Result
+    from .observe_report import write_observe_report
+
+    observation, assumptions = observe_result(Result.load(run_dir), bundled(*DEMO_PASS["tle"]), DEMO_PASS["site"],
+                                              DEMO_PASS["start"], DEMO_PASS["end"], step_s=DEMO_PASS["step_s"], draws=100,
+                                              rng=np.random.default_rng(seed))
+    content = write_observe_report(observation, out, assumptions)
+    over = content["over_pass"]
+    best = {}
+    for name in content["detectors"]:
+        row = max(content["times"], key=lambda r: r["p_detect"][name]["median"] or 0.0)
+        best[name] = (row["p_detect"][name]["median"], row["time_utc"], row["elevation_deg"])
+    lines = [f"{content['satellite']} from {DEMO_PASS['start']} to {DEMO_PASS['end']} over the paper's site, "
+             f"{over['steps_above_horizon']} steps above the horizon; a 1 m cube with a 4 m^2 sun-tracking panel of this "
+             f"material, the default camera (an IMX250MZR-class sensor behind the paper's 2.544 m^2 pupil), exposure {observation.camera.exposure_s:g} s."]
+    lines += [f"{name}: best median P_d {p:.3f} at {t} (elevation {e:.1f} deg); P(detected at least once over the pass) "
+              f"{over['p_detect'][name]['median']:.3f} [{over['p_detect'][name]['q05']:.3f}, {over['p_detect'][name]['q95']:.3f}]"
+              for name, (p, t, e) in best.items()]
+    lines.append(f"A target-free sky gives at least one false alarm over the pass with probability {over['p_false_alarm']:.3f}.")
+    return observation, lines
+
+
 def run_demo(out: Path, seed: int = 0) -> None:
     """The demo: forward model on PTFE, inversion, a hidden effect named on a synthetic set, diagnose and ladder on
     PTFE, Table 3 as distributions; report.html in ``out``."""
@@ -161,12 +192,12 @@ def run_demo(out: Path, seed: int = 0) -> None:
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
     measured = read_measurements(source).at_wavelength(0.633)
     data = measured.in_plane()
-    print(f"1/5 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
+    print(f"1/6 forward model on {len(data)} PTFE geometries (0.633 um, plane of incidence)")
     forward_lines = forward_comparison(data, out)
     for line in forward_lines:
         print("   " + line)
 
-    print("2/5 inversion of the PTFE measurement (full Mueller matrix + BRDF) with the paper's model")
+    print("2/6 inversion of the PTFE measurement (full Mueller matrix + BRDF) with the paper's model")
     posterior = Posterior.build(data, Model.from_string("paper"))
     inv = invert(posterior, seed=seed, backend_path=None, progress=True)
     summary = write_run_report(inv, out / "ptfe_paper", f"{source} (0.633 um, in-plane)", references={"n": PTFE_INDEX})
@@ -176,7 +207,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
           f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}")
 
     hidden_path = bundled("synthetic", "hidden_effect.csv")
-    print(f"3/5 what is missing? fit -> diagnose -> ladder on {hidden_path.name} (a synthetic set with a hidden effect)")
+    print(f"3/6 what is missing? fit -> diagnose -> ladder on {hidden_path.name} (a synthetic set with a hidden effect)")
     hidden = read_measurements(hidden_path)
     truth = hidden_truth(hidden.metadata)
     hidden_base = invert(Posterior.build(hidden, Model.from_string("paper")), seed=seed, progress=False)
@@ -185,14 +216,14 @@ def run_demo(out: Path, seed: int = 0) -> None:
         hidden_report["ranking"][0].get("tied_with", []) else "NOT found"
     print(f"   verdict {hidden_report['verdict']}; the hidden effect was {truth['hidden_effect']} ({found})")
 
-    print("4/5 what is missing from the paper's model on PTFE? diagnose -> ladder")
+    print("4/6 what is missing from the paper's model on PTFE? diagnose -> ladder")
     ptfe_report, ptfe_rungs = criticise(data, inv, out / "ptfe", f"{source} (0.633 um, in-plane)", seed)
     print("   " + significance_statement(ptfe_report))
     # what the measurement says about itself, no model: its out-of-plane rows hold the mirror pairs and the
     # theta_i = theta_r rows that the plane of incidence lacks
     itself = reciprocity.symmetry_findings(reciprocity.symmetry_checks(measured))
 
-    print("5/5 detecting a target of this material against the daytime sky: the paper's Table 3 as distributions")
+    print("5/6 detecting a target of this material against the daytime sky: the paper's Table 3 as distributions")
     scenario = default_scenario()
     contrast = make_contrast_report(inv, scenario, out / "contrast", "corrected", seed=seed,
                                     label=str(out / "ptfe_paper"))
@@ -202,6 +233,11 @@ def run_demo(out: Path, seed: int = 0) -> None:
     targets = {f"target {i + 1}": (c["zenith_deg"], c["azimuth_deg"]) for i, c in enumerate(scenario.cases)}
     save_figure(sky_maps_figure(RayleighSky(0.8), sun, targets), out / "contrast" / "sky_maps.png")
     save_figure(projection_distortion_figure(), out / "contrast" / "projections.png")
+
+    print("6/6 the same material on a daytime pass: the ISS over the paper's site, light curves and P_d per detector")
+    observation, observed = observe_demo_pass(out / "ptfe_paper", out / "observe", seed)
+    for line in observed:
+        print("   " + line)
 
     sections = [
         ("What this is", H.paragraph(
@@ -242,6 +278,9 @@ def run_demo(out: Path, seed: int = 0) -> None:
          + H.image(H.png_file_to_data_uri(out / "contrast" / "sky_maps.png"), "Sky DOP and AoP in the three projections, the two target directions in red.")
          + H.image(H.png_file_to_data_uri(out / "contrast" / "projections.png"), "What each projection does to shapes and areas.")
          + '<p><a href="contrast/report.html">Full contrast report (radiometry, the paper\'s Table 3 recomputed)</a></p>'),
+        ("6. A daytime pass", H.bullets(observed)
+         + H.image(H.png_file_to_data_uri(out / "observe" / "light_curves.png"), "Light curves and P_d(t) per detector.")
+         + '<p><a href="observe/report.html">Full pass report (assumptions, simulated exposures, every time step)</a></p>'),
     ]
     write_text(out / "report.html", H.page("spacepol demo: PTFE", sections))
-    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/, contrast/)")
+    print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/, contrast/, observe/)")

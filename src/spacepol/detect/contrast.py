@@ -19,6 +19,7 @@ from ..skylight.neutral_points import BerryDennisLeeSky
 from ..skylight.rayleigh import RayleighSky
 from ..skylight.sun import sun_position
 from . import radiometry as R
+from .table3_chain import chain_limit
 
 THETA_R_GRID = 81
 
@@ -155,6 +156,8 @@ def propagate(model, samples: dict, scenario, rng: np.random.Generator, draws: i
                        "limit_flux_photons_m2_s": flux, "limit_flux_for_required_snr": float(R.limit_flux(inst)),
                        "magnitude_of_limit_flux": float(R.magnitude(flux, inst))},
         "rows": rows, "draws_by_case": draws_out,
+        # the same limit asked of the pass chain's detector (detect.table3_chain): how the two compare
+        "limit_through_chain": chain_limit(inst, p_sky_mid),
     }
 
 

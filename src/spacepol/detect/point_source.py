@@ -74,14 +74,15 @@ class PointSourceStamp:
         return sky, sky + np.atleast_2d(stokes) @ per_stokes.T, sd
 
 
-def point_source_stamp(camera, sky_stokes: np.ndarray, centre: tuple[float, float], size_pixels: int = 18) -> PointSourceStamp:
+def point_source_stamp(camera, sky_stokes: np.ndarray, centre: tuple[float, float], size_pixels: int = 18,
+                       psf: np.ndarray | None = None) -> PointSourceStamp:
     """The stamp of ``size_pixels`` (even) on a side for ``camera`` under a uniform sky of Stokes photon rate
     ``sky_stokes`` (3,) per pixel (photons s^-1 before the analysers) with the target's PSF centred at ``centre``
-    (row, column in pixels)."""
+    (row, column in pixels): the camera's Gaussian, or ``psf`` (size_pixels, size_pixels; sum 1) as given."""
     shape = (size_pixels, size_pixels)
     sky_e = camera.expected_electrons(np.stack([np.full(shape, v) for v in sky_stokes]))
     variance = sky_e + camera.read_noise_e**2
-    psf = gaussian_psf(size_pixels, camera.psf_fwhm_pixels, centre)
+    psf = gaussian_psf(size_pixels, camera.psf_fwhm_pixels, centre) if psf is None else np.asarray(psf, float)
     theta = np.radians(camera.angle_map(shape))
     total, diff = camera.transmissions
     scale = 0.5 * camera.quantum_efficiency * camera.exposure_s * camera.transmittance * camera.aperture_area_m2

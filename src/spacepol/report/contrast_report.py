@@ -98,9 +98,24 @@ def write_contrast_report(report: dict, draws: dict, out: Path, run_dir: str, as
             ["N_s (e-)", "N_B (e-)", "noise (e-)", "SNR", "flux for the required SNR (photons m^-2 s^-1)"],
             [[f"{rad['N_s']:.1f}", f"{rad['N_B']:.2e}", f"{rad['noise']:.2f}", f"{rad['snr']:.2f}",
               f"{rad['limit_flux_for_required_snr']:.4g}"]])),
+        ("The limit through the pass chain's detector (observe)", _chain_paragraph(report)),
         ("The paper's Table 3 recomputed from its own inputs", H.table(
             ["case", "sky DOP", "limiting magnitude", "raw contrast", "polarization contrast", "verdict"], paper)
          + H.bullets([f"{p['case']} / {k}: {v['why']}" for p in report["paper_table3"] for k, v in p.items() if isinstance(v, dict)])),
     ]
     with atomic_path(out / "report.html") as tmp:
         tmp.write_text(H.page("spacepol contrast: detecting the target against the daytime sky", sections), encoding="utf-8")
+
+
+def _chain_paragraph(report: dict) -> str:
+    """The limiting magnitude three ways: the printed Phi_s (this report's), eq 38 solved, the pass chain's detector."""
+    chain = report.get("limit_through_chain")
+    if not chain:
+        return H.paragraph("Not computed.")
+    rows = [[label, f"{chain[key]['limit_flux_photons_m2_s']:.4g}", f"{chain[key]['limiting_magnitude']:.2f}"]
+            for key, label in (("printed", "the paper's printed Phi_s (the table above)"),
+                               ("eq38", "eq 38 solved for the required SNR"),
+                               ("chain", "the pass chain's intensity detector (observe), Table 2 as its camera"))]
+    return (H.table(["limit", "target flux at the aperture (photons m^-2 s^-1)", "limiting magnitude"], rows)
+            + H.paragraph("Table 3's target and sky DOP are the chain's at this geometry (tests). The limits differ: "
+                          + chain["why"]))

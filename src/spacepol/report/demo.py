@@ -229,6 +229,12 @@ def run_demo(out: Path, seed: int = 0) -> None:
                                     label=str(out / "ptfe_paper"))
     for line in table3_lines(contrast):
         print("   " + line)
+    limits = contrast["limit_through_chain"]
+    limit_line = ("limiting magnitude: " + ", ".join(f"{label} {limits[key]['limiting_magnitude']:.2f}" for key, label in
+                                                     (("printed", "the paper's Phi_s"), ("eq38", "eq 38 solved"),
+                                                      ("chain", "the pass chain's detector")))
+                  + " (the chain sums the spot's pixels: sqrt(k) more SNR)")
+    print("   " + limit_line)
     sun = (contrast["sun"]["zenith_deg"], contrast["sun"]["azimuth_deg"])
     targets = {f"target {i + 1}": (c["zenith_deg"], c["azimuth_deg"]) for i, c in enumerate(scenario.cases)}
     save_figure(sky_maps_figure(RayleighSky(0.8), sun, targets), out / "contrast" / "sky_maps.png")
@@ -274,7 +280,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
                    [[r["case"]] + [f"{r[k]['median']:.4g} [{r[k]['q05']:.4g}, {r[k]['q95']:.4g}]" for k in
                                    ("target_dop", "sky_dop", "limiting_magnitude", "intensity_contrast", "polarization_contrast")]
                     for r in contrast["rows"]])
-         + H.paragraph(contrast["dominance"])
+         + H.paragraph(contrast["dominance"]) + H.paragraph(limit_line.capitalize() + ".")
          + H.image(H.png_file_to_data_uri(out / "contrast" / "sky_maps.png"), "Sky DOP and AoP in the three projections, the two target directions in red.")
          + H.image(H.png_file_to_data_uri(out / "contrast" / "projections.png"), "What each projection does to shapes and areas.")
          + '<p><a href="contrast/report.html">Full contrast report (radiometry, the paper\'s Table 3 recomputed)</a></p>'),

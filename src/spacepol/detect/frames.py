@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from ..camera.mosaic import stokes_maps
 from .detection import gaussian_psf
+from .observation import sky_stokes_per_pixel
 
 
 def frame_field(observation, time_index: int, draw_index: int | None, superpixels: int = 24) -> np.ndarray:
@@ -16,17 +17,15 @@ def frame_field(observation, time_index: int, draw_index: int | None, superpixel
     target at ``time_index``: the uniform sky plus, unless ``draw_index`` is None, the target of that material draw
     through the PSF at the stamp's centre."""
     camera, n = observation.camera, superpixels
-    sky_aop = np.radians(observation.sky_aop_deg[time_index])
-    area = camera.transmittance * camera.aperture_area_m2  # photons m^-2 s^-1 -> photons s^-1 through the telescope
-    sky = observation.sky_photons_arcsec2[time_index] * camera.pixel_scale_arcsec**2 * area
-    p_sky = observation.sky_dolp[time_index]
-    field = np.stack([np.full((2 * n, 2 * n), v) for v in (sky, sky * p_sky * np.cos(2 * sky_aop), sky * p_sky * np.sin(2 * sky_aop))])
+    j = time_index
+    sky = sky_stokes_per_pixel(camera, observation.sky_photons_arcsec2[j], observation.sky_dolp[j], observation.sky_aop_deg[j])
+    field = np.stack([np.full((2 * n, 2 * n), v) for v in sky])
     if draw_index is None:
         return field
     s = observation.light.stokes_w_m2[:, draw_index, time_index] * observation.light.photons_per_joule
     if np.all(np.isfinite(s)) and s[0] > 0:
         psf = gaussian_psf(2 * n, camera.psf_fwhm_pixels)  # on the pixel grid, sum 1
-        field = field + np.stack([s[k] * psf for k in range(3)]) * area
+        field = field + np.stack([s[k] * psf for k in range(3)]) * camera.transmittance * camera.aperture_area_m2
     return field
 
 

@@ -127,15 +127,13 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
     sky_aop = _sky_aop(geometry)
     positions = superpixel_positions(stamp_pixels, positions_per_side)
     per_place = max(dolp_frames // len(positions), 1)
-    pixel_area = camera.pixel_scale_arcsec**2 * camera.transmittance * camera.aperture_area_m2  # arcsec^2 m^2 per pixel
     n_draws, n_times = light.photons_m2_s.shape
     deflection = {k: np.full((n_draws, n_times), np.nan) for k in ("intensity", "stokes")}
     p_detect = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
     for j in range(n_times):
         if geometry.elevation_deg[j] <= 0:
             continue
-        psi = np.radians(sky_aop[j])
-        sky = sky_photons[j] * pixel_area * np.array([1.0, sky_dolp[j] * np.cos(2 * psi), sky_dolp[j] * np.sin(2 * psi)])
+        sky = sky_stokes_per_pixel(camera, sky_photons[j], sky_dolp[j], sky_aop[j])
         stokes = (light.stokes_w_m2[:3, :, j] * light.photons_per_joule).T  # (D, 3) photons m^-2 s^-1
         lit = np.all(np.isfinite(stokes), axis=1) & (np.nan_to_num(stokes[:, 0]) > 0)
         stokes = np.where(lit[:, None], stokes, 0.0)
@@ -161,6 +159,13 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
             p_detect["dolp"][:, j] += p_dolp / len(positions)
     return Observation(geometry, light, sky_photons, sky_dolp, deflection, p_detect, p_false_alarm, camera, sky_aop,
                        stacked=stacked, dolp_frames=per_place * len(positions))
+
+
+def sky_stokes_per_pixel(camera, radiance_photons_m2_s_arcsec2: float, dolp: float, aop_deg: float) -> np.ndarray:
+    """(3,) the sky's linear Stokes photon rate on one pixel of ``camera`` before its analyser (photons s^-1)."""
+    rate = radiance_photons_m2_s_arcsec2 * camera.pixel_scale_arcsec**2 * camera.transmittance * camera.aperture_area_m2
+    psi = np.radians(aop_deg)
+    return rate * np.array([1.0, dolp * np.cos(2 * psi), dolp * np.sin(2 * psi)])
 
 
 def sky_dolp_at(geometry, p_max: float = 0.7) -> np.ndarray:

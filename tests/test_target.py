@@ -152,3 +152,33 @@ def test_the_chain_gives_contrasts_sky_dop_at_table_3s_directions():
         assert np.all((chain > 0.05) & (chain < p_max))
     geometry.sun_azimuth_deg = np.full(n, -(4 + 32 / 60))  # the paper's stated azimuth
     assert np.abs(sky_dolp_at(geometry, p_max) - expected).max() > 0.01
+
+
+def test_a_face_of_its_own_fixed_material_adds_its_light_and_ignores_the_runs_draws(tle, tmp_path):
+    """A panel of fixed aluminium-like parameters beside a body of the run's material: the target's Stokes flux is
+    the sum of the two faces' alone, the panel's is the same for every draw and equals the run's model evaluated at
+    those fixed values; a material with an unknown parameter is one line."""
+    from spacepol.errors import ParameterError
+    from spacepol.orbit import faces_from_toml, pass_geometry
+
+    aluminium = {"model": "specular+smith", "n": 1.37, "k": 7.6, "sigma": 0.1, "ks": 0.9}
+    window = ("2014-01-21T00:33:00Z", "2014-01-21T00:40:00Z", 30.0)
+    body, panel = Face("body", 20.0, "nadir", (0, 0, 1)), Face("panel", 60.0, "sun", material=aluminium)
+    model = Model.from_string("specular+shadowing+body")
+    draws = {"n": np.array([1.4, 1.5, 1.6]), "rho_d": np.array([0.1, 0.2, 0.3])}
+
+    def light(faces, m=model, d=draws):
+        return target_light(pass_geometry(tle, SITE, *window, faces), m, d, BAND).stokes_w_m2
+
+    both, alone = light([body, panel]), light([panel])
+    assert np.abs(both - light([body]) - alone).max() <= 1e-12 * np.abs(both).max()
+    assert np.abs(alone).max() > 0 and np.allclose(alone, alone[:, :1, :], rtol=1e-12, atol=0)
+    as_run = light([Face("panel", 60.0, "sun")], Model.from_string("specular+smith"),
+                   {k: v for k, v in aluminium.items() if k != "model"})
+    assert np.allclose(alone[:, 0], as_run[:, 0], rtol=1e-12, atol=0)
+    path = tmp_path / "target.toml"
+    path.write_text('[[faces]]\nname = "panel"\narea_m2 = 4\norientation = "sun"\n'
+                    'material = {model = "specular+smith", n = 1.4, roughness = 0.2}\n')
+    face = faces_from_toml(path)[0]
+    with pytest.raises(ParameterError, match="no parameter roughness"):
+        light([face])

@@ -27,7 +27,7 @@ import numpy as np
 from .detection import dolp_detection_probability, neyman_pearson
 from .point_source import point_source_stamp, superpixel_positions
 from .radiometry import background_photon_flux
-from .target import bands_over_draws, sky_basis, target_light
+from .target import bands_over_draws, fixed_material, sky_basis, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
@@ -224,6 +224,9 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     rng = np.random.default_rng(0) if rng is None else rng
     faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
     camera = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+    for face in faces:  # a face's own material is checked before the pass is computed
+        if face.material is not None:
+            fixed_material(face.material)
     element_set = read_tle(tle, satellite)
     geometry = pass_geometry(element_set, site, start, end, step_s, faces)
     if not camera.exposure_set:  # no exposure given: the one that keeps the brightest sky of the pass at half the well
@@ -242,7 +245,7 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     assumptions = [
         f"Satellite {element_set.name} from {element_set.source} (SGP4, skyfield), site {site[0]:.4f}, {site[1]:.4f} deg, "
         f"{site[2]:g} m; {len(geometry.times_utc)} times every {step_s:g} s.",
-        f"Target: {len(faces)} faces ({', '.join(f'{f.name} {f.area_m2:g} m^2 {f.orientation}' for f in faces)}); "
+        f"Target: {len(faces)} faces ({', '.join(f'{f.name} {f.area_m2:g} m^2 {f.orientation}' + _material_words(f) for f in faces)}); "
         "shadows between faces and light reflected between them are left out.",
         f"Material: {len(pick)} draws of the posterior of {result.summary['model']}; {material['rule']}.",
         f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
@@ -258,3 +261,10 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
         f"{exposures_per_step} exposure(s) averaged per time; P_d over the pass assumes independent frames.",
     ]
     return observation, assumptions
+
+
+def _material_words(face) -> str:
+    if face.material is None:
+        return ""
+    values = ", ".join(f"{k} {v:g}" for k, v in face.material.items() if k != "model")
+    return f" of fixed {face.material['model']} ({values})"

@@ -107,9 +107,13 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
     lit_faces = on.sum(axis=1)
     times, faces = np.nonzero(on)
     if times.size:
-        # every (time, face) that sends light in one evaluation of the model
         g = Geometry(geometry.theta_i_deg[times, faces], geometry.theta_r_deg[times, faces], geometry.dphi_deg[times, faces])
-        sr = np.asarray(model.evaluate(params, g).stokes, float).reshape(4, -1, times.size)  # (4, D or 1, rows) sr^-1
+        sr = np.zeros((4, n_draws, times.size))
+        # every (time, face) of one material in one evaluation of its model: the run's, or a face's fixed one
+        for material, rows in _by_material(geometry.faces, faces).items():
+            face_model, face_params = (model, params) if material is None else fixed_material(material)
+            sub = Geometry(g.theta_i[rows], g.theta_r[rows], g.dphi[rows])
+            sr[:, :, rows] = np.asarray(face_model.evaluate(face_params, sub).stokes, float).reshape(4, -1, rows.size)
         area = np.array([f.area_m2 for f in geometry.faces])[faces]
         ti, tr = np.radians(geometry.theta_i_deg[times, faces]), np.radians(geometry.theta_r_deg[times, faces])
         scale = irradiance * np.cos(ti) * area * np.cos(tr) / (geometry.range_km[times] * 1e3) ** 2
@@ -124,3 +128,27 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         dolp = np.where(lit, np.hypot(stokes[1], stokes[2]) / np.where(lit, stokes[0], 1.0), np.nan)
         aop = np.where(lit, 0.5 * np.degrees(np.arctan2(stokes[2], stokes[1])), np.nan)
     return TargetLight(stokes, stokes[0] * photons / irradiance, dolp, aop, lit_faces, photons / irradiance)
+
+
+def _by_material(faces, face_index: np.ndarray) -> dict:
+    """{material key (None: the run's; else the fixed material's items): rows of ``face_index`` made of it}."""
+    keys = [None if f.material is None else tuple(sorted(f.material.items())) for f in faces]
+    groups: dict = {}
+    for row, k in enumerate(face_index):
+        groups.setdefault(keys[k], []).append(row)
+    return {k: np.array(v) for k, v in groups.items()}
+
+
+def fixed_material(material) -> tuple:
+    """(Model, parameters) of a face's fixed material: its ``model`` spec and values (the rest at their defaults);
+    an unknown model or parameter is one line."""
+    from ..physics.model import Model
+
+    values = dict(material)
+    spec = values.pop("model")
+    model = Model.from_string(spec)
+    names = {p.name for p in model.parameters}
+    unknown = sorted(set(values) - names)
+    if unknown:
+        raise ParameterError(f"face material {spec}: no parameter {', '.join(unknown)} (it has {', '.join(sorted(names))})")
+    return model, {k: float(v) for k, v in values.items()}

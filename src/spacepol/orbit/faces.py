@@ -1,5 +1,7 @@
-"""A target's faces from a TOML file (``[[faces]]`` tables: name, area_m2, orientation, normal), and the default
-target: a 1 m cube bus in the orbit frame with a 4 m^2 sun-tracking panel."""
+"""A target's faces from a TOML file (``[[faces]]`` tables: name, area_m2, orientation, normal, and optionally a
+``material`` table of fixed parameters, ``{model = "specular+smith", n = 1.37, k = 7.6, sigma = 0.1, ks = 0.9}``,
+where the face is not made of the observed run's material), and the default target: a 1 m cube bus in the orbit
+frame with a 4 m^2 sun-tracking panel."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from .pass_geometry import Face
 
-FACE_KEYS = {"name", "area_m2", "orientation", "normal"}
+FACE_KEYS = {"name", "area_m2", "orientation", "normal", "material"}
 
 
 def default_faces() -> list[Face]:
@@ -39,9 +41,13 @@ def faces_from_toml(path) -> list[Face]:
             raise ParameterError(f"--target {path}: face {k} has no key {', '.join(unknown)} (known: {', '.join(sorted(FACE_KEYS))})")
         if "area_m2" not in table:
             raise ParameterError(f"--target {path}: face {k} needs area_m2")
+        material = table.get("material")
+        if material is not None and not (isinstance(material, dict) and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for key, v in material.items() if key != "model")):
+            raise ParameterError(f"--target {path}: face {k}: material must be a table of model = \"...\" and numbers")
         try:
             faces.append(Face(str(table.get("name", f"face{k}")), float(table["area_m2"]), str(table.get("orientation", "nadir")),
-                              tuple(float(v) for v in table.get("normal", (0.0, 0.0, 1.0)))))
+                              tuple(float(v) for v in table.get("normal", (0.0, 0.0, 1.0))), material))
         except (TypeError, ValueError) as exc:
             raise ParameterError(f"--target {path}: face {k}: {exc}") from None
     names = [f.name for f in faces]

@@ -35,12 +35,14 @@ class Face:
     """A flat face of the target: ``area_m2`` and how its outward ``normal`` points. ``orientation``: ``nadir`` (a
     nadir-pointing body: ``normal`` in the orbit frame, x along the velocity, z towards the Earth's centre, y
     completing it), ``sun`` (a panel that tracks the sun: its normal is the sun's direction, ``normal`` unused),
-    ``inertial`` (``normal`` fixed in the celestial frame GCRS)."""
+    ``inertial`` (``normal`` fixed in the celestial frame GCRS). ``material``: None for the observed run's material
+    (its posterior draws), else fixed parameters {"model": spec, name: value, ...} of a model of the library."""
 
     name: str
     area_m2: float
     orientation: str = "nadir"
     normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    material: dict | None = None
 
     def __post_init__(self):
         if self.orientation not in ORIENTATIONS:
@@ -50,6 +52,8 @@ class Face:
         norm = float(np.linalg.norm(self.normal))
         if len(self.normal) != 3 or not np.isfinite(norm) or norm == 0:
             raise ParameterError(f"face '{self.name}': normal {tuple(self.normal)} must be three finite numbers, not all 0")
+        if self.material is not None and not isinstance(self.material.get("model"), str):
+            raise ParameterError(f"face '{self.name}': material needs model = \"...\" (a model of the library) and its parameters")
 
     def normals(self, position_km: np.ndarray, velocity_km_s: np.ndarray, sun_unit: np.ndarray) -> np.ndarray:
         """(3, N) unit outward normals in GCRS at each time (positions, velocities and sun directions (3, N))."""

@@ -57,6 +57,23 @@ def test_the_stokes_detector_is_never_below_intensity(observation):
     assert 1e-7 < observation.camera.exposure_s < 1e-2
 
 
+def test_a_brighter_sky_lowers_the_deflection_and_an_unpolarized_one_leaves_only_the_targets_polarization(observation):
+    """The sky's level and P_max are the user's to set: a sky 0.5 mag brighter (1.58x, below saturation with the
+    exposure kept) costs the intensity filter deflection (more background noise: about 1 / sqrt(1.58) where the sky
+    dominates the noise), and with P_max 0 the sky has no DoLP anywhere."""
+    g, camera = observation.geometry, observation.camera
+    model = Model.from_string("specular+smith")
+    draws = {k: v[:5] for k, v in {"n": np.full(40, 1.3), "k": np.full(40, 7.5), "sigma": np.full(40, 0.15),
+                                   "ks": np.full(40, 0.9)}.items()}
+    base = observe_pass(g, model, draws, camera, dolp_frames=160)
+    bright = observe_pass(g, model, draws, camera, sky_magnitude_zenith=5.40 - 0.5, dolp_frames=160)
+    seen = np.nan_to_num(base.deflection["intensity"]) > 1.0
+    ratio = bright.deflection["intensity"][seen] / base.deflection["intensity"][seen]
+    assert seen.any() and np.all((ratio > 0.7) & (ratio < 0.9)), ratio
+    flat = observe_pass(g, model, draws, camera, p_max=0.0, dolp_frames=160)
+    assert np.all(flat.sky_dolp == 0.0) and np.nanmax(base.sky_dolp) > 0.1
+
+
 def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_line(tmp_path):
     import json
     import subprocess
@@ -77,10 +94,14 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
     assert content["satellite"] == "ISS (ZARYA)" and len(content["times"]) == 13 and content["p_false_alarm"] == 1e-3
     assert (tmp_path / "obs" / "light_curves.png").stat().st_size > 0 and "P_d" in (tmp_path / "obs" / "report.html").read_text()
     assert "best P_d" in done.stdout
-    for bad, words in ((["--site", "95,125"], "--site '95,125'"), (["--start", "2014-01-21T00:33:00"], "UTC offset")):
+    for bad, words in ((["--site", "95,125"], "--site '95,125'"), (["--start", "2014-01-21T00:33:00"], "UTC offset"),
+                       (["--p-max", "1.5"], "--p-max 1.5")):
         argv = list(args)
         flag = bad[0]
-        argv[argv.index(flag) + 1] = bad[1]
+        if flag in argv:
+            argv[argv.index(flag) + 1] = bad[1]
+        else:
+            argv += bad
         failed = subprocess.run(argv + ["--out", str(tmp_path / "bad")], capture_output=True, text=True)
         assert failed.returncode == 2 and words in failed.stderr, failed.stderr
         assert len(failed.stderr.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()

@@ -378,13 +378,14 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
 
 def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, satellite: str | None = None, target=None,
             camera=None, draws: int = 200, seed: int = 0, p_false_alarm: float = 1e-3, band_um=(1.5, 1.8), out=None,
-            progress: bool = False, exposures_per_step: int = 1):
+            progress: bool = False, exposures_per_step: int = 1, sky_magnitude_zenith: float = 5.40, p_max: float = 0.7):
     """A pass of the satellite of ``tle`` (a TLE file; ``satellite`` picks one of several) over ``site`` ((lat_deg,
     lon_deg[, height_m]) or "LAT,LON[,HEIGHT_M]") from ``start`` to ``end`` (ISO 8601 with offset) every ``step_s``
     seconds, its faces (``target``: a TOML file of [[faces]] or a list of ``orbit.Face``; default a 1 m cube with a
     4 m^2 sun-tracking panel) made of the Result's material (``draws`` posterior draws, n and k at the band's centre
     for a run over several wavelengths), seen by ``camera`` (a TOML file's [camera], a ``camera.sensor.Camera``, or
-    the default), ``exposures_per_step`` exposures averaged at each time. Returns the ``detect.observation.Observation``:
+    the default), ``exposures_per_step`` exposures averaged at each time, under a sky of ``sky_magnitude_zenith`` mag
+    arcsec^-2 at the zenith (CIE clear-sky pattern) polarized up to ``p_max`` (Rayleigh). Returns the ``detect.observation.Observation``:
     P_d(t) per detector (intensity and Stokes matched filters, the DoLP image) at ``p_false_alarm``, P_d over the
     whole pass, light curves with their posterior bands; with ``out`` observe.json, light_curves.png and
     report.html."""
@@ -399,12 +400,16 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
         raise ParameterError(f"--draws {draws}: need a whole number of at least 1")
     if not (isinstance(exposures_per_step, int) and exposures_per_step >= 1):
         raise ParameterError(f"--exposures {exposures_per_step}: need a whole number of at least 1")
+    sky_magnitude_zenith = _finite_number("sky-zenith-mag", sky_magnitude_zenith)
+    if not 0 <= _finite_number("p-max", p_max) <= 1:
+        raise ParameterError(f"--p-max {p_max:g}: a degree of polarization, within [0, 1]")
     if not 0 < p_false_alarm < 0.5:
         raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
     observation, assumptions = observe_result(result, tle, site, start, end, step_s=step_s, satellite=satellite,
                                               target=target, camera=camera, draws=draws, rng=np.random.default_rng(seed),
                                               p_false_alarm=p_false_alarm, band_um=band_um, progress=progress,
-                                              exposures_per_step=exposures_per_step)
+                                              exposures_per_step=exposures_per_step,
+                                              sky_magnitude_zenith=sky_magnitude_zenith, p_max=p_max)
     if out is not None:
         from .report.observe_report import write_observe_report
 

@@ -201,6 +201,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default=None, metavar="FILE.toml", help="[camera] (default: an IMX250MZR-class sensor)")
     p.add_argument("--draws", type=_int_at_least(1), default=200, help="posterior draws of the material")
     p.add_argument("--exposures", type=_int_at_least(1), default=1, metavar="N", help="exposures averaged per time step")
+    p.add_argument("--sky-zenith-mag", type=float, default=5.40, metavar="MAG",
+                   help="the sky's radiance at the zenith in the band, mag arcsec^-2 (default 5.40, the paper's)")
+    p.add_argument("--p-max", type=float, default=0.7, help="the sky's maximum degree of polarization (Rayleigh)")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/observe")
     for p in sub.choices.values():  # --effect also after the command name, where users put it

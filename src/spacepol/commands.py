@@ -374,7 +374,8 @@ def observe(args) -> int:
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "observe")
     observation = observe_pass(Result.load(args.run_dir), args.tle, args.site, args.start, args.end, step_s=args.step,
                                satellite=args.satellite, target=args.target, camera=args.camera, draws=args.draws,
-                               seed=args.seed, out=out, progress=True, exposures_per_step=args.exposures)
+                               seed=args.seed, out=out, progress=True, exposures_per_step=args.exposures,
+                               sky_magnitude_zenith=args.sky_zenith_mag, p_max=args.p_max)
     content = observation.to_json()
     rows = content["times"]
     for name in observation.p_detect:

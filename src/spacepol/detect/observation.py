@@ -20,6 +20,8 @@ the horizon and the sky's turbidity are not modelled further.
 
 from __future__ import annotations
 
+import sys
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,7 +115,7 @@ def _num(x) -> float | None:
 def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_false_alarm: float = 1e-3,
                  sky_magnitude_zenith: float = 5.40, p_max: float = 0.7, stamp_pixels: int = 18,
                  rng: np.random.Generator | None = None, stacked: int = 1, dolp_frames: int = 2000,
-                 positions_per_side: int = 4) -> Observation:
+                 positions_per_side: int = 4, progress: bool = False) -> Observation:
     """P_d over the pass ``geometry`` (with the target's faces) for the material ``model`` at ``draws`` seen by
     ``camera`` (``camera.sensor.Camera``), each time step ``stacked`` exposures averaged. Each detector's P_d is
     the mean over ``positions_per_side``^2 places of the target within a superpixel (``detect.point_source``): the
@@ -130,7 +132,10 @@ def observe_pass(geometry, model, draws: dict, camera, band_um=(1.5, 1.8), p_fal
     n_draws, n_times = light.photons_m2_s.shape
     deflection = {k: np.full((n_draws, n_times), np.nan) for k in ("intensity", "stokes")}
     p_detect = {k: np.full((n_draws, n_times), np.nan) for k in DETECTORS}
+    started = time.perf_counter()
     for j in range(n_times):
+        if progress and j and j % max(1, n_times // 10) == 0:
+            print(f"  observe: {j}/{n_times} times, {time.perf_counter() - started:.0f} s", file=sys.stderr)
         if geometry.elevation_deg[j] <= 0:
             continue
         sky = sky_stokes_per_pixel(camera, sky_photons[j], sky_dolp[j], sky_aop[j])
@@ -207,12 +212,13 @@ def _sky_aop(geometry) -> np.ndarray:
 def observe_result(result, tle, site: tuple[float, float, float], start, end, *, step_s: float = 10.0,
                    satellite: str | None = None, target=None, camera=None, draws: int = 200,
                    rng: np.random.Generator | None = None, p_false_alarm: float = 1e-3, band_um=(1.5, 1.8),
-                   progress: bool = False, exposures_per_step: int = 1) -> tuple[Observation, list[str]]:
+                   progress: bool = False, exposures_per_step: int = 1, sky_magnitude_zenith: float = 5.40,
+                   p_max: float = 0.7) -> tuple[Observation, list[str]]:
     """A run's material (``result``: an ``infer.Result``, ``draws`` of its posterior) on a satellite's pass: the
     elements of ``tle`` (``satellite`` picks one), the faces of ``target`` (a TOML file, a list of ``orbit.Face``, or
     the default cube with a panel), seen by ``camera`` (a TOML file, a ``Camera``, or the default, its exposure set
-    from the pass where not given). Returns the Observation and the report's sentences on what it assumed."""
-    import sys
+    from the pass where not given), under a sky of ``sky_magnitude_zenith`` mag arcsec^-2 at the zenith polarized up
+    to ``p_max``. Returns the Observation and the report's sentences on what it assumed."""
     from dataclasses import replace
     from pathlib import Path
 
@@ -241,7 +247,8 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     if progress:
         print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
               f"{result.summary['model']}", file=sys.stderr)
-    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm, rng=rng, stacked=exposures_per_step)
+    observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm, sky_magnitude_zenith, p_max,
+                               rng=rng, stacked=exposures_per_step, progress=progress)
     assumptions = [
         f"Satellite {element_set.name} from {element_set.source} (SGP4, skyfield), site {site[0]:.4f}, {site[1]:.4f} deg, "
         f"{site[2]:g} m; {len(geometry.times_utc)} times every {step_s:g} s.",
@@ -249,7 +256,8 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
         "shadows between faces and light reflected between them are left out.",
         f"Material: {len(pick)} draws of the posterior of {result.summary['model']}; {material['rule']}.",
         f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
-        "5.40 mag arcsec^-2 at the zenith (the paper's), Rayleigh polarization with P_max 0.7.",
+        f"{sky_magnitude_zenith:g} mag arcsec^-2 at the zenith (default 5.40, what the paper's Table 3 implies), single "
+        f"Rayleigh scattering's polarization with P_max {p_max:g}.",
         f"Camera: {camera.layout.name}, extinction ratio {camera.extinction_ratio:g}, QE {camera.quantum_efficiency:g}, read "
         f"noise {camera.read_noise_e:g} e, exposure {camera.exposure_s:g} s (set where not given: the brightest sky of the "
         f"pass at half the full well), {camera.pixel_scale_arcsec:g} arcsec pixels, "

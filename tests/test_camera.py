@@ -77,3 +77,31 @@ def test_a_frame_that_is_not_a_raw_mosaic_is_one_line(tmp_path):
     with pytest.raises(SpacepolError, match="not an image"):
         read_raw_frame(tmp_path / "x.png") if (tmp_path / "x.png").write_text("no") else None
     assert IMX250MZR.offset(0.0) == (1, 1) and IMX250MZR.offset(90.0) == (0, 0)
+
+
+def test_a_raw_frame_from_the_command_line_and_the_api(tmp_path, capsys):
+    """``invert-mcmc frame RAW.png``: the maps' files, the API's maps equal ``stokes_maps`` of the file; a colour
+    image or a missing file is one line, exit status 2, nothing written."""
+    import json
+
+    import spacepol
+    from spacepol import cli
+    from spacepol.camera.mosaic import stokes_maps
+
+    raw = bundled("dofp", "polarizer_IMX250MZR.png")
+    assert cli.main(["frame", str(raw), "--out", str(tmp_path / "frame")]) == 0
+    content = json.loads((tmp_path / "frame" / "frame.json").read_text())
+    arrays = np.load(tmp_path / "frame" / "stokes.npz")
+    expected = stokes_maps(raw)
+    assert content["shape"] == list(expected.stokes.shape[1:]) and np.array_equal(arrays["s1"], expected.stokes[1])
+    assert (tmp_path / "frame" / "frame.png").stat().st_size > 0 and 0 < content["dolp"]["median"] < 1
+    maps = spacepol.frame(raw, "bilinear")  # full resolution: twice the superpixels' on each side
+    assert maps.stokes.shape[1:] == tuple(2 * n for n in expected.stokes.shape[1:])
+    from PIL import Image
+
+    Image.fromarray(np.zeros((8, 8, 3), np.uint8)).save(tmp_path / "colour.png")
+    capsys.readouterr()
+    for bad, words in ((tmp_path / "colour.png", "one channel"), (tmp_path / "missing.png", "not found")):
+        rc = cli.main(["frame", str(bad), "--out", str(tmp_path / "bad")])
+        err = capsys.readouterr().err.strip()
+        assert rc == 2 and words in err and len(err.splitlines()) == 1 and not (tmp_path / "bad").exists(), err

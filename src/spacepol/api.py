@@ -417,6 +417,26 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
     return observation
 
 
+def frame(path, method: str = "superpixel", out=None):
+    """A raw micro-polarizer frame (an 8- or 16-bit single-channel image of the IMX250MZR mosaic) as Stokes, DoLP
+    and AoP maps (``camera.mosaic.StokesMaps``): ``method`` "superpixel" (half resolution, no interpolation) or
+    "bilinear" (full resolution, polanalyser's interpolation). With ``out``: frame.png, stokes.npz, frame.json."""
+    from .camera.mosaic import stokes_maps
+
+    if method not in ("superpixel", "bilinear"):
+        raise ParameterError(f"--method {method}: superpixel or bilinear")
+    if out is not None:
+        from .io.output import check_output_dir
+
+        out = check_output_dir(Path(out))
+    maps = stokes_maps(Path(path), method=method)
+    if out is not None:
+        from .report.frame_report import write_frame_report
+
+        write_frame_report(maps, out)
+    return maps
+
+
 def _site(value) -> tuple[float, float, float]:
     """A site as "LAT,LON[,HEIGHT_M]" text or a tuple, checked."""
     text = value if isinstance(value, str) else ",".join(str(v) for v in value)

@@ -206,6 +206,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--p-max", type=float, default=0.7, help="the sky's maximum degree of polarization (Rayleigh)")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/observe")
+    p = sub.add_parser("frame", help="a raw micro-polarizer frame (IMX250MZR mosaic) as Stokes, DoLP and AoP maps")
+    p.add_argument("raw", metavar="RAW.png", help="an 8- or 16-bit single-channel image of the raw mosaic")
+    p.add_argument("--method", choices=("superpixel", "bilinear"), default="superpixel")
+    p.add_argument("--out", default=None, help="default: a folder named after the image, beside it")
     for p in sub.choices.values():  # --effect also after the command name, where users put it
         p.add_argument("--effect", action="append", default=[], dest="effect_after", metavar="FILE.py:NAME",
                        help="load a user-defined effect (repeatable); it is then usable by name")

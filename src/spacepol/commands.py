@@ -386,3 +386,17 @@ def observe(args) -> int:
     print(f"over the pass a target-free sky gives a false alarm with probability {content['over_pass']['p_false_alarm']:.3f}")
     print(f"wrote {out}/observe.json, light_curves.png, report.html")
     return 0
+
+
+def frame(args) -> int:
+    """``invert-mcmc frame``: a raw frame's maps (``api.frame``); prints their DoLP."""
+    from .api import frame as read_frame
+
+    raw = Path(args.raw)
+    out = check_output_dir(Path(args.out) if args.out else raw.with_suffix(""))
+    content = read_frame(raw, args.method, out=out).to_json()
+    d = content["dolp"]
+    print(f"{raw.name}: {content['shape'][0]} x {content['shape'][1]} {args.method} pixels, DoLP median {d['median']:.3f} "
+          f"[5 %, 95 %: {d['q05']:.3f}, {d['q95']:.3f}]")
+    print(f"wrote {out}/frame.png, stokes.npz, frame.json")
+    return 0

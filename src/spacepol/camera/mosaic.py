@@ -129,6 +129,13 @@ class StokesMaps:
         """Angle of polarization per pixel, [0, 180) deg."""
         return aop_deg(self.stokes)
 
+    def to_json(self) -> dict:
+        """What was read and the maps' statistics: shape, method, source, S0's mean and DoLP's quantiles."""
+        finite = self.dolp[np.isfinite(self.dolp)]
+        q05, median, q95 = (float(x) for x in np.percentile(finite, [5, 50, 95])) if finite.size else (None,) * 3
+        return {"source": self.source, "method": self.method, "shape": list(self.stokes.shape[1:]),
+                "s0_mean_counts": float(np.mean(self.stokes[0])), "dolp": {"median": median, "q05": q05, "q95": q95}}
+
     def region(self, centre_xy: tuple[float, float], radius: float) -> dict:
         """The mean Stokes vector, DoLP and AoP (of the mean vector) in a disc (centre and radius in raw pixels)."""
         scale = 2.0 if self.method == "superpixel" else 1.0

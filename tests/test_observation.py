@@ -65,12 +65,12 @@ def test_a_brighter_sky_lowers_the_deflection_and_an_unpolarized_one_leaves_only
     model = Model.from_string("specular+smith")
     draws = {k: v[:5] for k, v in {"n": np.full(40, 1.3), "k": np.full(40, 7.5), "sigma": np.full(40, 0.15),
                                    "ks": np.full(40, 0.9)}.items()}
-    base = observe_pass(g, model, draws, camera, dolp_frames=160)
-    bright = observe_pass(g, model, draws, camera, sky_magnitude_zenith=5.40 - 0.5, dolp_frames=160)
+    base = observe_pass(g, model, draws, camera, dolp_frames=160, positions_per_side=1)
+    bright = observe_pass(g, model, draws, camera, sky_magnitude_zenith=5.40 - 0.5, dolp_frames=160, positions_per_side=1)
     seen = np.nan_to_num(base.deflection["intensity"]) > 1.0
     ratio = bright.deflection["intensity"][seen] / base.deflection["intensity"][seen]
     assert seen.any() and np.all((ratio > 0.7) & (ratio < 0.9)), ratio
-    flat = observe_pass(g, model, draws, camera, p_max=0.0, dolp_frames=160)
+    flat = observe_pass(g, model, draws, camera, p_max=0.0, dolp_frames=160, positions_per_side=1)
     assert np.all(flat.sky_dolp == 0.0) and np.nanmax(base.sky_dolp) > 0.1
 
 
@@ -87,7 +87,7 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
     (run / "summary.json").write_text(json.dumps(summary))
     tle = bundled("tle", "iss_zarya_2014-01-20.tle")
     args = [sys.executable, "-m", "spacepol.cli", "observe", str(run), "--tle", str(tle), "--site", "43.1333,125.5333,200",
-            "--start", "2014-01-21T00:33:00Z", "--end", "2014-01-21T00:39:00Z", "--step", "30", "--draws", "50"]
+            "--start", "2014-01-21T00:33:00Z", "--end", "2014-01-21T00:39:00Z", "--step", "30", "--draws", "10"]
     done = subprocess.run(args + ["--out", str(tmp_path / "obs")], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     content = json.loads((tmp_path / "obs" / "observe.json").read_text())

@@ -376,16 +376,17 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
     return Contrast(content, per_case)
 
 
-def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, satellite: str | None = None, target=None,
+def observe(result: Result | str | Path, tle, site, start, end, *, step_s: float = 10.0, satellite: str | None = None, target=None,
             camera=None, draws: int = 200, seed: int = 0, p_false_alarm: float = 1e-3, band_um=(1.5, 1.8), out=None,
             progress: bool = False, exposures_per_step: int = 1, sky_magnitude_zenith: float = 5.40, p_max: float = 0.7):
     """A pass of the satellite of ``tle`` (a TLE file; ``satellite`` picks one of several) over ``site`` ((lat_deg,
     lon_deg[, height_m]) or "LAT,LON[,HEIGHT_M]") from ``start`` to ``end`` (ISO 8601 with offset) every ``step_s``
     seconds, its faces (``target``: a TOML file of [[faces]] or a list of ``orbit.Face``; default a 1 m cube with a
-    4 m^2 sun-tracking panel) made of the Result's material (``draws`` posterior draws, n and k at the band's centre
-    for a run over several wavelengths), seen by ``camera`` (a TOML file's [camera], a ``camera.sensor.Camera``, or
-    the default), ``exposures_per_step`` exposures averaged at each time, under a sky of ``sky_magnitude_zenith`` mag
-    arcsec^-2 at the zenith (CIE clear-sky pattern) polarized up to ``p_max`` (Rayleigh). Returns the ``detect.observation.Observation``:
+    4 m^2 sun-tracking panel) made of the material of ``result`` (a Result, or its run folder, read after every
+    other argument is checked; ``draws`` posterior draws, n and k at the band's centre for a run over several
+    wavelengths), seen by ``camera`` (a TOML file's [camera], a ``camera.sensor.Camera``, or the default),
+    ``exposures_per_step`` exposures averaged at each time, under a sky of ``sky_magnitude_zenith`` mag arcsec^-2 at
+    the zenith (CIE clear-sky pattern) polarized up to ``p_max`` (Rayleigh). Returns the ``detect.observation.Observation``:
     P_d(t) per detector (intensity and Stokes matched filters, the DoLP image) at ``p_false_alarm``, P_d over the
     whole pass, light curves with their posterior bands; with ``out`` observe.json, light_curves.png and
     report.html."""
@@ -405,6 +406,11 @@ def observe(result: Result, tle, site, start, end, *, step_s: float = 10.0, sate
         raise ParameterError(f"--p-max {p_max:g}: a degree of polarization, within [0, 1]")
     if not 0 < p_false_alarm < 0.5:
         raise ParameterError(f"--p-false-alarm {p_false_alarm:g}: need a probability in (0, 0.5)")
+    from .orbit.pass_geometry import time_steps
+
+    time_steps(start, end, step_s)  # the window, checked before the run is read
+    if not isinstance(result, Result):  # a run folder
+        result = Result.load(result)
     observation, assumptions = observe_result(result, tle, site, start, end, step_s=step_s, satellite=satellite,
                                               target=target, camera=camera, draws=draws, rng=np.random.default_rng(seed),
                                               p_false_alarm=p_false_alarm, band_um=band_um, progress=progress,

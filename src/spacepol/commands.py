@@ -369,10 +369,9 @@ def observe(args) -> int:
     """``invert-mcmc observe``: a run folder's Result over a satellite's pass (``api.observe``); prints where the
     target is detectable."""
     from .api import observe as observe_pass
-    from .infer.result import Result
 
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "observe")
-    observation = observe_pass(Result.load(args.run_dir), args.tle, args.site, args.start, args.end, step_s=args.step,
+    observation = observe_pass(args.run_dir, args.tle, args.site, args.start, args.end, step_s=args.step,
                                satellite=args.satellite, target=args.target, camera=args.camera, draws=args.draws,
                                seed=args.seed, out=out, progress=True, exposures_per_step=args.exposures,
                                sky_magnitude_zenith=args.sky_zenith_mag, p_max=args.p_max)

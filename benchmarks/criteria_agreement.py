@@ -9,7 +9,8 @@ weights are trusted, else nested sampling). From the same refits, the LOO rule p
 2 SE and > 4, the evidence rule the best with ln B > 3 and > 2 errors. By default one case per effect (its first
 value at the lower noise) and four null sets; ``--cases all``: the whole suite. Prints one line per case, the
 agreement rate, and writes ``criteria.json``, ``criteria.md`` (the table) and ``criteria.png`` (delta ELPD-LOO
-against ln B for every refitted change, both thresholds drawn).
+against ln B for every refitted change, both thresholds drawn). Each finished case is kept in
+``criteria.partial.json``: the same command after a stop continues with the cases not yet done.
 """
 
 import argparse
@@ -60,8 +61,16 @@ def main():
         if args.cases != "default":
             cases = cases[: int(args.cases)]
     print(f"load average before: {os.getloadavg()[0]:.2f}; {len(cases)} cases", flush=True)
-    rows, points, start = [], [], time.perf_counter()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    partial = out / "criteria.partial.json"  # each finished case, so a stopped run continues with the same command
+    done = json.loads(partial.read_text()) if partial.exists() else {"cases": [], "refits": []}
+    rows, points, start = done["cases"], done["refits"], time.perf_counter()
+    finished = {r["case"] for r in rows}
     for k, case in enumerate(cases, start=1):
+        if case.label in finished:
+            print(f"[{k}/{len(cases)}] {case.label:<28s} done before", flush=True)
+            continue
         t = time.perf_counter()
         report = diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(case.seed), seed=0,
                           progress=False, criterion="evidence")
@@ -78,11 +87,10 @@ def main():
         print(f"[{k}/{len(cases)}] {case.label:<28s} LOO: {loo:<32s} evidence: {evidence:<32s} "
               f"{'agree' if loo == evidence else 'twins' if rows[-1]['twins'] else 'DIFFER'} ({rows[-1]['seconds']:.0f} s)",
               flush=True)
+        partial.write_text(json.dumps({"cases": rows, "refits": points}, indent=1))
     agree = sum(r["agree"] for r in rows)
     print(f"the two criteria pick the same change in {agree} of {len(rows)} cases; {time.perf_counter() - start:.0f} s; "
           f"load average after: {os.getloadavg()[0]:.2f}")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     (out / "criteria.json").write_text(json.dumps({"cases": rows, "refits": points}, indent=1))
     lines = ["| case | hidden | LOO picks | evidence picks | same |", "|---|---|---|---|---|"]
     lines += [f"| {r['case']} | {r['hidden']} | {r['loo']} | {r['evidence']} | "

@@ -369,6 +369,7 @@ def observe(args) -> int:
     """``invert-mcmc observe``: a run folder's Result over a satellite's pass (``api.observe``); prints where the
     target is detectable."""
     from .api import observe as observe_pass
+    from .report.observe_report import best_times
 
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "observe")
     observation = observe_pass(args.run_dir, args.tle, args.site, args.start, args.end, step_s=args.step,
@@ -376,9 +377,7 @@ def observe(args) -> int:
                                seed=args.seed, out=out, progress=True, exposures_per_step=args.exposures,
                                sky_magnitude_zenith=args.sky_zenith_mag, p_max=args.p_max)
     content = observation.to_json()
-    rows = content["times"]
-    for name in observation.p_detect:
-        best = max(rows, key=lambda r: r["p_detect"][name]["median"] or 0.0)
+    for name, best in best_times(content).items():
         print(f"{name}: best P_d {best['p_detect'][name]['median']:.3f} at {best['time_utc']} "
               f"(elevation {best['elevation_deg']:.1f} deg, phase {best['phase_angle_deg']:.1f} deg); over the pass "
               f"{content['over_pass']['p_detect'][name]['median']:.3f}")

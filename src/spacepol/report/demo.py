@@ -164,17 +164,15 @@ def observe_demo_pass(run_dir: Path, out: Path, seed: int) -> tuple:
     """The run's material on the bundled daytime pass (DEMO_PASS): observe/ and what it found, in sentences."""
     from ..detect.observation import observe_result
     from ..infer.result import Result
-    from .observe_report import write_observe_report
+    from .observe_report import best_times, write_observe_report
 
     observation, assumptions = observe_result(Result.load(run_dir), bundled(*DEMO_PASS["tle"]), DEMO_PASS["site"],
                                               DEMO_PASS["start"], DEMO_PASS["end"], step_s=DEMO_PASS["step_s"], draws=100,
                                               rng=np.random.default_rng(seed))
     content = write_observe_report(observation, out, assumptions)
     over = content["over_pass"]
-    best = {}
-    for name in content["detectors"]:
-        row = max(content["times"], key=lambda r: r["p_detect"][name]["median"] or 0.0)
-        best[name] = (row["p_detect"][name]["median"], row["time_utc"], row["elevation_deg"])
+    best = {name: (row["p_detect"][name]["median"], row["time_utc"], row["elevation_deg"])
+            for name, row in best_times(content).items()}
     lines = [f"{content['satellite']} from {DEMO_PASS['start']} to {DEMO_PASS['end']} over the paper's site, "
              f"{over['steps_above_horizon']} steps above the horizon; a 1 m cube with a 4 m^2 sun-tracking panel of this "
              f"material, the default camera (an IMX250MZR-class sensor behind the paper's 2.544 m^2 pupil), exposure {observation.camera.exposure_s:g} s."]
@@ -187,7 +185,7 @@ def observe_demo_pass(run_dir: Path, out: Path, seed: int) -> tuple:
 
 def run_demo(out: Path, seed: int = 0) -> None:
     """The demo: forward model on PTFE, inversion, a hidden effect named on a synthetic set, diagnose and ladder on
-    PTFE, Table 3 as distributions; report.html in ``out``."""
+    PTFE, Table 3 as distributions, the material on a daytime pass; report.html in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     source = bundled("ptfe", "ptfe_mueller_brdf.csv")
     measured = read_measurements(source).at_wavelength(0.633)
@@ -241,7 +239,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
     save_figure(projection_distortion_figure(), out / "contrast" / "projections.png")
 
     print("6/6 the same material on a daytime pass: the ISS over the paper's site, light curves and P_d per detector")
-    observation, observed = observe_demo_pass(out / "ptfe_paper", out / "observe", seed)
+    _, observed = observe_demo_pass(out / "ptfe_paper", out / "observe", seed)
     for line in observed:
         print("   " + line)
 

@@ -57,6 +57,11 @@ def light_curves_figure(observation, fig=None) -> Figure:
     return fig
 
 
+def best_times(content: dict) -> dict:
+    """{detector: observe.json's row where its median P_d is highest}."""
+    return {name: max(content["times"], key=lambda r: r["p_detect"][name]["median"] or 0.0) for name in content["detectors"]}
+
+
 def montage_times(observation, count: int = 4) -> list[int]:
     """Up to ``count`` times for the frame montage: the one where the intensity detector does best and others spread
     over the times the satellite is above the horizon."""

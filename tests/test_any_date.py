@@ -4,8 +4,6 @@ low-precision solar coordinates (good to ~0.01 deg for 1950-2050), written here 
 astropy; the contrast command runs for both dates too."""
 
 import json
-import subprocess
-import sys
 from datetime import datetime, timedelta, timezone
 
 import numpy as np
@@ -13,6 +11,7 @@ import pytest
 
 from spacepol.skylight.sun import sun_position
 from test_contrast import _run_dir
+from cli_runner import run_cli
 
 TODAY = datetime.now(timezone.utc).replace(hour=4, minute=0, second=0, microsecond=0)
 DATES = {"today": TODAY, "in five years": TODAY.replace(year=TODAY.year + 5) if not (TODAY.month == 2 and TODAY.day == 29)
@@ -59,8 +58,8 @@ def test_the_almanac_check_fails_for_an_hour_off():
 @pytest.mark.parametrize("label", list(DATES))
 def test_sky_and_contrast_commands_run_for_today_and_five_years_ahead(tmp_path, label):
     iso = DATES[label].isoformat()
-    sky = subprocess.run([sys.executable, "-m", "spacepol.cli", "sky", "--lat", str(SITE[0]), "--lon", str(SITE[1]),
-                          "--time", iso, "--direction", "60,101.5", "--out", str(tmp_path / "sky")], capture_output=True, text=True)
+    sky = run_cli("sky", "--lat", str(SITE[0]), "--lon", str(SITE[1]),
+                  "--time", iso, "--direction", "60,101.5", "--out", str(tmp_path / "sky"))
     assert sky.returncode == 0, sky.stderr
     assert "Traceback" not in sky.stderr and len([s for s in sky.stderr.splitlines() if s.strip()]) <= 1  # one note at most
     report = json.loads((tmp_path / "sky" / "sky.json").read_text())
@@ -70,8 +69,8 @@ def test_sky_and_contrast_commands_run_for_today_and_five_years_ahead(tmp_path, 
     run = _run_dir(tmp_path)
     scenario = tmp_path / "s.toml"
     scenario.write_text(f'[site]\ntime = "{iso}"\n')
-    contrast = subprocess.run([sys.executable, "-m", "spacepol.cli", "contrast", str(run), "--scenario", str(scenario),
-                               "--draws", "500", "--out", str(tmp_path / "c")], capture_output=True, text=True)
+    contrast = run_cli("contrast", str(run), "--scenario", str(scenario),
+                       "--draws", "500", "--out", str(tmp_path / "c"))
     assert contrast.returncode == 0, contrast.stderr
     rows = json.loads((tmp_path / "c" / "contrast.json").read_text())["rows"]
     assert all(np.isfinite(r["sky_dop"]["median"]) for r in rows)

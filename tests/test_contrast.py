@@ -1,8 +1,6 @@
 """`invert-mcmc contrast` (issue 5): posterior -> Table 3 distributions; scenario files; bad input."""
 
 import json
-import subprocess
-import sys
 
 import arviz as az
 import numpy as np
@@ -11,6 +9,7 @@ import pytest
 from spacepol.detect.scenario import read_scenario
 from spacepol.physics import Model
 from spacepol.physics.geometry import Geometry
+from cli_runner import run_cli
 
 TRUTH = {"n": 1.5, "k": 0.0, "sigma": 0.25, "ks": 0.6, "rho_d": 0.3}
 
@@ -26,8 +25,9 @@ def _run_dir(tmp_path, spread=0.0, seed=0):
     return run
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "spacepol.cli", *map(str, args)], capture_output=True, text=True)
+def _cli(*args, cwd=None):
+    """The command line in this process (``cli_runner``): its exit status, stdout and stderr."""
+    return run_cli(*args, cwd=cwd)
 
 
 def test_contrast_of_a_point_posterior_is_exact(tmp_path):

@@ -1,13 +1,13 @@
 """`diagnose` (issue 4): a hidden effect is named; DESIGN's JSON fields; nulls, twins, priors, PTFE."""
 
 import json
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
 from spacepol.io.measurements import write_table
+from cli_runner import run_cli
 
 
 def _hidden_polarized_diffuse(tmp_path):
@@ -25,9 +25,9 @@ def _hidden_polarized_diffuse(tmp_path):
 def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
     data = _hidden_polarized_diffuse(tmp_path)
     out = tmp_path / "diag.json"
-    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", data, "--model", "paper", "--json", out,
-                          "--candidates", "polarized_diffuse", "extinction", "dop_bias", "--top", "2",
-                          "--out", tmp_path / "figs"], capture_output=True, text=True)
+    run = run_cli("diagnose", data, "--model", "paper", "--json", out,
+                  "--candidates", "polarized_diffuse", "extinction", "dop_bias", "--top", "2",
+                  "--out", tmp_path / "figs")
     assert run.returncode == 0, run.stderr
     report = json.loads(out.read_text())
     assert set(report) >= {"model", "fit", "ranking", "verdict"}
@@ -46,9 +46,8 @@ def test_diagnose_names_a_hidden_polarized_diffuse(tmp_path):
 def test_diagnose_rejects_unknown_candidates(tmp_path):
     from spacepol.paths import bundled
 
-    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
-                          "--wavelength-um", "0.633", "--json", tmp_path / "d.json", "--candidates", "sparkle"],
-                         capture_output=True, text=True)
+    run = run_cli("diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
+                  "--wavelength-um", "0.633", "--json", tmp_path / "d.json", "--candidates", "sparkle")
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1
     assert "unknown effect 'sparkle'" in run.stderr and not (tmp_path / "d.json").exists()
 
@@ -106,9 +105,8 @@ def test_diagnose_prior_file_applies_to_candidates_and_rejects_unknown_names(tmp
 
     prior = tmp_path / "p.toml"
     prior.write_text('[sparkle]\ndistribution = "uniform"\nlower = 0\nupper = 1\n')
-    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
-                          "--wavelength-um", "0.633", "--json", tmp_path / "d.json", "--prior", prior],
-                         capture_output=True, text=True)
+    run = run_cli("diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
+                  "--wavelength-um", "0.633", "--json", tmp_path / "d.json", "--prior", prior)
     assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1, run.stderr
     assert "sparkle" in run.stderr and not (tmp_path / "d.json").exists()
 
@@ -143,8 +141,8 @@ def test_ptfe_diagnosis_states_which_effects_improve_elpd(tmp_path):
     from spacepol.paths import bundled
 
     out, js = tmp_path / "ptfe", tmp_path / "ptfe.json"
-    run = subprocess.run([sys.executable, "-m", "spacepol.cli", "diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
-                          "--wavelength-um", "0.633", "--in-plane", "--json", js, "--out", out], capture_output=True, text=True)
+    run = run_cli("diagnose", bundled("ptfe", "ptfe_mueller_brdf.csv"),
+                  "--wavelength-um", "0.633", "--in-plane", "--json", js, "--out", out)
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads(js.read_text())
     confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]

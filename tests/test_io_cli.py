@@ -1,7 +1,5 @@
 """Measurement files and the CLI: good input round-trips, bad input gets one line and exit 2."""
 
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -10,12 +8,14 @@ from spacepol.errors import InputFileError
 from spacepol.io import read_measurements
 from spacepol.paths import bundled
 from spacepol.physics import Model
+from cli_runner import run_cli
 
 GOOD = "# material: test\n# wavelength_um: 1.55\ntheta_i,theta_r,dop,dop_err\n30,10,0.1,0.01\n30,40,0.2,0.01\n"
 
 
 def cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "spacepol.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+    """The command line in this process (``cli_runner``): its exit status, stdout and stderr."""
+    return run_cli(*args, cwd=cwd)
 
 
 def test_reads_metadata_and_defaults(tmp_path):

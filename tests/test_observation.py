@@ -76,9 +76,7 @@ def test_a_brighter_sky_lowers_the_deflection_and_an_unpolarized_one_leaves_only
 
 def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_line(tmp_path):
     import json
-    import subprocess
-    import sys
-
+    from cli_runner import run_cli
     from test_contrast import _run_dir
 
     run = _run_dir(tmp_path, spread=1.0)
@@ -86,9 +84,9 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
     summary["fixed"] = {"sigma_p": Model.from_string(summary["model"]).parameter("sigma_p").default}
     (run / "summary.json").write_text(json.dumps(summary))
     tle = bundled("tle", "iss_zarya_2014-01-20.tle")
-    args = [sys.executable, "-m", "spacepol.cli", "observe", str(run), "--tle", str(tle), "--site", "43.1333,125.5333,200",
+    args = ["observe", str(run), "--tle", str(tle), "--site", "43.1333,125.5333,200",
             "--start", "2014-01-21T00:33:00Z", "--end", "2014-01-21T00:39:00Z", "--step", "30", "--draws", "10"]
-    done = subprocess.run(args + ["--out", str(tmp_path / "obs")], capture_output=True, text=True)
+    done = run_cli(*args, "--out", tmp_path / "obs")
     assert done.returncode == 0, done.stderr
     content = json.loads((tmp_path / "obs" / "observe.json").read_text())
     assert content["satellite"] == "ISS (ZARYA)" and len(content["times"]) == 13 and content["p_false_alarm"] == 1e-3
@@ -102,7 +100,7 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
             argv[argv.index(flag) + 1] = bad[1]
         else:
             argv += bad
-        failed = subprocess.run(argv + ["--out", str(tmp_path / "bad")], capture_output=True, text=True)
+        failed = run_cli(*argv, "--out", tmp_path / "bad")
         assert failed.returncode == 2 and words in failed.stderr, failed.stderr
         assert len(failed.stderr.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()
 

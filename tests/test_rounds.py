@@ -14,9 +14,16 @@ from spacepol.io.measurements import Dataset, write_table
 from spacepol.physics import Model
 from spacepol.physics.geometry import default_grid
 from spacepol.physics.registry import registry
+from cli_runner import run_cli
 
 
 def _cli(*args):
+    """The command line in this process (``cli_runner``)."""
+    return run_cli(*args)
+
+
+def _cli_process(*args):
+    """The command line in a process of its own: for a plug-in loaded with --effect, which would stay registered."""
     return subprocess.run([sys.executable, "-m", "spacepol.cli", *map(str, args)], capture_output=True, text=True)
 
 
@@ -96,7 +103,7 @@ def test_a_plugin_declaring_twins_is_reported_as_tied(plugins, tmp_path):
     and reported tied, with the separating measurement the plug-in declares."""
     data = _write(tmp_path / "ext.csv", "paper+extinction", {"n": 1.5, "k": 0.0, "sigma": 0.2, "ks": 0.6, "rho_d": 0.2, "e": 0.75})
     out = tmp_path / "d.json"
-    run = _cli("diagnose", data, "--effect", f"{plugins}:Analyser", "--model", "paper", "--candidates", "extinction",
+    run = _cli_process("diagnose", data, "--effect", f"{plugins}:Analyser", "--model", "paper", "--candidates", "extinction",
                "leaky_analyser", "dop_bias", "--top", "1", "--json", out, "--out", tmp_path / "dg")
     assert run.returncode == 0, run.stderr
     report = json.loads(out.read_text())

@@ -1,19 +1,19 @@
 """`invert-mcmc run`, `optimize` and `compare` end to end, and their bad-input errors."""
 
 import json
-import subprocess
-import sys
 
 import arviz as az
 import pytest
 
 from spacepol.paths import bundled
+from cli_runner import run_cli
 
 PTFE = str(bundled("ptfe", "ptfe_mueller_brdf.csv"))
 
 
-def cli(*args):
-    return subprocess.run([sys.executable, "-m", "spacepol.cli", *map(str, args)], capture_output=True, text=True)
+def cli(*args, cwd=None):
+    """The command line in this process (``cli_runner``): its exit status, stdout and stderr."""
+    return run_cli(*args, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

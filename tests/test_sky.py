@@ -7,6 +7,7 @@ from spacepol.skylight.directions import fold_axial, local_frame, unit_vector
 from spacepol.skylight.neutral_points import BerryDennisLeeSky
 from spacepol.skylight.rayleigh import RayleighSky, paper_aop
 from spacepol.skylight.sun import sun_position
+from cli_runner import run_cli
 
 
 def test_sun_at_changchun_on_16_december_2020():
@@ -133,13 +134,10 @@ def test_singularity_indices_sun_plus_one_neutral_points_plus_half():
 
 def test_sky_command_writes_sky_json_and_maps(tmp_path):
     import json
-    import subprocess
-    import sys
 
     out = tmp_path / "sky"
-    r = subprocess.run([sys.executable, "-m", "spacepol.cli", "sky", "--lat", "43.1333", "--lon", "125.5333", "--time",
-                        "2020-12-16T11:42+08:00", "--direction", "60,101.47", "--model", "berry-dennis-lee", "--out", out],
-                       capture_output=True, text=True)
+    r = run_cli("sky", "--lat", "43.1333", "--lon", "125.5333", "--time",
+                "2020-12-16T11:42+08:00", "--direction", "60,101.47", "--model", "berry-dennis-lee", "--out", out)
     assert r.returncode == 0, r.stderr
     report = json.loads((out / "sky.json").read_text())
     assert report["sun"]["zenith_deg"] == pytest.approx(66.49, abs=0.05)
@@ -151,6 +149,6 @@ def test_sky_command_writes_sky_json_and_maps(tmp_path):
     assert report["projections"]["stereographic"]["max_angular_distortion_deg"] < 1e-9
     for name in ("sky_maps.png", "projections.png"):
         assert (out / name).stat().st_size > 0
-    bad = subprocess.run([sys.executable, "-m", "spacepol.cli", "sky", "--lat", "43", "--lon", "125", "--time",
-                          "2020-12-16T11:42+08:00", "--direction", "100,0", "--out", tmp_path / "bad"], capture_output=True, text=True)
+    bad = run_cli("sky", "--lat", "43", "--lon", "125", "--time",
+                  "2020-12-16T11:42+08:00", "--direction", "100,0", "--out", tmp_path / "bad")
     assert bad.returncode == 2 and "zenith angle must lie in [0, 90]" in bad.stderr and not (tmp_path / "bad").exists()

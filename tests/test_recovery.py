@@ -24,6 +24,16 @@ def start(*args):
                             stderr=subprocess.STDOUT, text=True, env=ENV)
 
 
+def stopped_at(text, *args) -> list[str]:
+    """Start ``invert-mcmc ARGS``, read its output until a line holds ``text``, kill it; returns the lines read."""
+    proc = start(*args)
+    try:
+        return wait_for(proc, text)
+    finally:
+        proc.kill()
+        proc.wait()
+
+
 def wait_for(proc, text, timeout=240):
     """Read the process's output until a line contains ``text``; returns the lines read."""
     lines, deadline = [], time.time() + timeout
@@ -149,13 +159,8 @@ def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
         proc.wait()
     # the killed run held the lock only while it lived: the same command takes the folder and continues the chain
     # (stopped once it says so: running it to convergence would prove nothing more)
-    third = start("run", data, *slow, "--steps", "20000", "--out", out)
-    try:
-        lines = wait_for(third, "resuming the chain")
-        assert not any("in use by another" in line for line in lines), lines
-    finally:
-        third.kill()
-        third.wait()
+    lines = stopped_at("resuming the chain", "run", data, *slow, "--steps", "20000", "--out", out)
+    assert not any("in use by another" in line for line in lines), lines
 
 
 def test_a_failed_run_leaves_nothing_that_blocks_the_corrected_command(data, tmp_path):
@@ -164,10 +169,5 @@ def test_a_failed_run_leaves_nothing_that_blocks_the_corrected_command(data, tmp
     assert bad.returncode == 2 and not out.exists()
     # the corrected command takes the folder and samples (stopped there: the finished runs of the other tests show
     # that a run completes)
-    good = start("run", data, *RUN, "--steps", "300", "--out", out)
-    try:
-        lines = wait_for(good, "sampling ")
-        assert not any("error" in line for line in lines), lines
-    finally:
-        good.kill()
-        good.wait()
+    lines = stopped_at("sampling ", "run", data, *RUN, "--steps", "300", "--out", out)
+    assert not any("error" in line for line in lines), lines

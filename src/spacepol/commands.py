@@ -394,7 +394,8 @@ def frame(args) -> int:
     out = check_output_dir(Path(args.out) if args.out else raw.with_suffix(""))
     content = read_frame(raw, args.method, out=out).to_json()
     d = content["dolp"]
-    print(f"{raw.name}: {content['shape'][0]} x {content['shape'][1]} {args.method} pixels, DoLP median {d['median']:.3f} "
+    unit = "superpixels" if args.method == "superpixel" else "pixels (bilinear)"
+    print(f"{raw.name}: {content['shape'][0]} x {content['shape'][1]} {unit}, DoLP median {d['median']:.3f} "
           f"[5 %, 95 %: {d['q05']:.3f}, {d['q95']:.3f}]")
     print(f"wrote {out}/frame.png, stokes.npz, frame.json")
     return 0

@@ -41,6 +41,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="default", help="'all', or how many of the default selection")
     ap.add_argument("--out", default="reports/criteria")
+    ap.add_argument("--start", type=int, default=1, help="begin at this case (1-based): a second process on the other "
+                                                          "core takes the later cases into its own --out")
     args = ap.parse_args()
     from spacepol import configure_process
 
@@ -68,6 +70,8 @@ def main():
     rows, points, start = done["cases"], done["refits"], time.perf_counter()
     finished = {r["case"] for r in rows}
     for k, case in enumerate(cases, start=1):
+        if k < args.start:
+            continue
         if case.label in finished:
             print(f"[{k}/{len(cases)}] {case.label:<28s} done before", flush=True)
             continue

@@ -41,6 +41,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--cases", default="default", help="'all', or how many of the default selection")
     ap.add_argument("--out", default="reports/criteria")
+    ap.add_argument("--report-only", action="store_true", help="write the table and figure from the cases done so far "
+                                                                 "(criteria.partial.json), running none")
+    ap.add_argument("--merge", default=None, metavar="DIR", help="add the finished cases of another --out folder first")
     ap.add_argument("--start", type=int, default=1, help="begin at this case (1-based): a second process on the other "
                                                           "core takes the later cases into its own --out")
     args = ap.parse_args()
@@ -67,8 +70,18 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     partial = out / "criteria.partial.json"  # each finished case, so a stopped run continues with the same command
     done = json.loads(partial.read_text()) if partial.exists() else {"cases": [], "refits": []}
+    if args.merge:
+        other = json.loads((Path(args.merge) / "criteria.partial.json").read_text())
+        known = {r["case"] for r in done["cases"]}
+        done["cases"] += [r for r in other["cases"] if r["case"] not in known]
+        done["refits"] += [p for p in other["refits"] if p["case"] not in known]
+        partial.write_text(json.dumps(done, indent=1))
     rows, points, start = done["cases"], done["refits"], time.perf_counter()
     finished = {r["case"] for r in rows}
+    if args.report_only:
+        order = {c.label: k for k, c in enumerate(cases)}
+        rows.sort(key=lambda r: order.get(r["case"], len(order)))
+        cases = []
     for k, case in enumerate(cases, start=1):
         if k < args.start:
             continue
@@ -99,7 +112,8 @@ def main():
     lines = ["| case | hidden | LOO picks | evidence picks | same |", "|---|---|---|---|---|"]
     lines += [f"| {r['case']} | {r['hidden']} | {r['loo']} | {r['evidence']} | "
               f"{'yes' if r['agree'] else 'twins' if r['twins'] else '**no**'} |" for r in rows]
-    lines.append(f"\nSame change in {agree} of {len(rows)} cases.")
+    lines.append(f"\nSame change in {agree} of {len(rows)} cases; where not, twins (declared, tied by LOO) in "
+                 f"{sum(r['twins'] for r in rows)}.")
     (out / "criteria.md").write_text("\n".join(lines) + "\n")
     fig = Figure(figsize=(5.5, 4.5), layout="constrained")
     ax = fig.subplots()

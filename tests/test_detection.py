@@ -117,3 +117,18 @@ def test_the_dolp_detectors_pd_from_channel_fluxes_equals_full_frames_and_stacki
                                                       1e-3, rng, target_frames=20_000)[0]
     p_full, error_full = measured[4]
     assert abs(single_against_stack - p_full) > 4 * np.hypot(error_full, 0.03)
+
+
+def test_the_dolp_threshold_from_sky_draws_in_chunks_is_the_quantile_of_all_of_them(monkeypatch):
+    """A small P_fa needs 20 / P_fa sky-only draws: drawn in chunks, keeping only the largest statistics, the
+    threshold (and so P_d) is exactly the one from all the draws at once (the same random numbers)."""
+    import spacepol.detect.detection as detection
+
+    sky, sd = np.array([1000.0, 800.0, 600.0, 800.0]), np.full(4, 30.0)
+    target = sky[None, :] + np.array([[40.0, 0.0, -40.0, 0.0], [10.0, 0.0, -10.0, 0.0]])
+    whole = detection.dolp_detection_probability(sky, target, sd, 1e-3, np.random.default_rng(1), sky_frames=50_000,
+                                                 target_frames=4000)
+    monkeypatch.setattr(detection, "SKY_CHUNK", 7000)
+    chunked = detection.dolp_detection_probability(sky, target, sd, 1e-3, np.random.default_rng(1), sky_frames=50_000,
+                                                   target_frames=4000)
+    assert np.array_equal(whole, chunked) and whole[0] > whole[1] > 0.0

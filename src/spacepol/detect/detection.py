@@ -28,6 +28,7 @@ from scipy import stats
 from ..camera.mosaic import dolp, linear_stokes
 
 DETECTORS = ("intensity", "stokes", "dolp")
+SKY_CHUNK = 200_000  # sky-only draws held at once by the DoLP detector's threshold
 
 
 def gaussian_psf(size: int, fwhm_pixels: float, centre: tuple[float, float] | None = None) -> np.ndarray:
@@ -99,8 +100,22 @@ def dolp_detection_probability(sky_flux: np.ndarray, target_flux: np.ndarray, fl
     sky_flux, flux_sd = np.asarray(sky_flux, float), np.asarray(flux_sd, float)
     target_flux = np.atleast_2d(np.asarray(target_flux, float))
     sky_frames = int(np.ceil(20 / p_false_alarm)) if sky_frames is None else sky_frames
-    sky = dolp_contrast(sky_flux + flux_sd * rng.standard_normal((sky_frames, 4)), sky_flux)
-    threshold = threshold_from_sky(sky, p_false_alarm)
+    if sky_frames <= SKY_CHUNK:
+        threshold = threshold_from_sky(dolp_contrast(sky_flux + flux_sd * rng.standard_normal((sky_frames, 4)), sky_flux),
+                                       p_false_alarm)
+    else:  # a small P_fa: the sky-only draws in chunks, keeping only the largest statistics the quantile needs
+        keep = int(np.ceil(sky_frames * p_false_alarm)) + 2
+        top = np.empty(0)
+        for first in range(0, sky_frames, SKY_CHUNK):
+            count = min(SKY_CHUNK, sky_frames - first)
+            chunk = dolp_contrast(sky_flux + flux_sd * rng.standard_normal((count, 4)), sky_flux)
+            top = np.partition(np.concatenate([top, chunk]), -keep)[-keep:] if top.size + count > keep else \
+                np.concatenate([top, chunk])
+        # numpy's linear quantile at 1 - P_fa over all sky_frames statistics, from the largest ones alone
+        position = (1.0 - p_false_alarm) * (sky_frames - 1) - (sky_frames - keep)
+        ordered = np.sort(top)
+        low = int(np.floor(position))
+        threshold = float(ordered[low] + (position - low) * (ordered[min(low + 1, keep - 1)] - ordered[low]))
     frames = target_flux[:, None, :] + flux_sd * rng.standard_normal((len(target_flux), target_frames, 4))
     return np.mean(dolp_contrast(frames, sky_flux) > threshold, axis=1)
 

@@ -26,14 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .detection import dolp_detection_probability, neyman_pearson
+from .detection import DETECTORS, dolp_detection_probability, neyman_pearson
 from .point_source import point_source_stamp, superpixel_positions
 from .radiometry import background_photon_flux
 from .target import bands_over_draws, fixed_material, sky_basis, target_light
 
 # CIE general sky type 12 (clear, low turbidity): gradation a, b and indicatrix c, d, e
 CIE_CLEAR = {"a": -1.0, "b": -0.32, "c": 10.0, "d": -3.0, "e": 0.45}
-DETECTORS = ("intensity", "stokes", "dolp")
 
 
 def cie_relative_radiance(view_zenith_deg, scattering_deg, sun_zenith_deg, sky=CIE_CLEAR):

@@ -10,7 +10,7 @@ own noise), at 0.633 um and at 0.633 + 1.064 um: 15 normalised Mueller elements 
 the paper's model, every registered effect a candidate. Each repeat runs in a fresh process with an empty JAX
 cache folder, so every compilation is paid as a user's first run pays it (``--warm`` keeps one cache folder for
 all repeats: a second run of the same command). Prints per repeat the wall time, the split of round 1 into base
-fit, screening and confirmation, the path; then the median and the machine's load average before and after.
+fit, screening and confirmation, the programs XLA compiled and their seconds, the path; then the median and the machine's load average before and after.
 """
 
 import argparse
@@ -30,6 +30,16 @@ def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress:
     from spacepol import configure_process
 
     configure_process(small_calls=True)  # as the command line runs
+    import jax.monitoring
+
+    compiled = {"count": 0, "seconds": 0.0}
+
+    def on_event(event: str, seconds: float, **_) -> None:
+        if event == "/jax/core/compile/backend_compile_duration":  # XLA's compilation of one program
+            compiled["count"] += 1
+            compiled["seconds"] += seconds
+
+    jax.monitoring.register_event_duration_secs_listener(on_event)
     from spacepol.criticism.rounds import diagnose_rounds
     from spacepol.infer.measured_noise import reciprocal_pairs
     from spacepol.io import read_measurements
@@ -51,7 +61,7 @@ def child(wavelengths: list[float], rounds: int, seed: int, size: int, progress:
     out = diagnose_rounds(data, model, np.random.default_rng(seed), rounds, seed=seed, progress=progress, workers=workers)
     wall = time.perf_counter() - start
     print(json.dumps({"wall": wall, "rows": len(data), "numbers": 16 * len(data), "seconds": out["seconds"],
-                      "path": [r["change"] or r["model"] for r in out["rounds"]], "final": out["final_model"],
+                      "path": [r["change"] or r["model"] for r in out["rounds"]], "final": out["final_model"], "compiled": compiled,
                       "noise": {k: v["ratio"] for k, v in out["rounds"][-1]["noise"].items()}}))
 
 
@@ -88,7 +98,8 @@ def main():
                 print(f"{spec} um, seed {seed}: {row['wall']:6.1f} s for {args.rounds} rounds on {row['rows']} rows "
                       f"({row['numbers']} numbers); round 1: base fit {s['base_fit']:.0f} s, screening {s['screening']:.0f} s "
                       f"({s['candidates_screened']} candidates), confirmation {s['confirmation']:.0f} s "
-                      f"({s['candidates_refitted']} refits); path {' -> '.join(row['path'])}; "
+                      f"({s['candidates_refitted']} refits); XLA compiled {row['compiled']['count']} programs in "
+                      f"{row['compiled']['seconds']:.0f} s; path {' -> '.join(row['path'])}; "
                       f"misfit ratios {', '.join(f'{k} {v:.2f}' for k, v in row['noise'].items())}", flush=True)
             n = len(spec.split(","))
             median = float(np.median(walls))

@@ -236,3 +236,63 @@ def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
             assert elpd_one == pytest.approx(elpd_two, rel=1e-9, abs=1e-9), change
     other, _ = ranking(1, seed=case.seed + 1)
     assert any(abs(other[c][0] - one[c][0]) > 1e-6 for c in one), (one, other)
+
+
+_POOL_SCRIPT = """
+import sys, time
+from concurrent.futures import ProcessPoolExecutor
+import multiprocessing
+from spacepol.criticism.candidate_fits import CandidateFits
+
+if __name__ == "__main__":
+    if sys.argv[1] == "fits":
+        pool = CandidateFits(None, workers=2)._open()
+    else:  # the control: the same pool without diagnose's initializer
+        pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn"))
+    futures = [pool.submit(time.sleep, 120) for _ in range(2)]
+    while len(pool._processes) < 2:
+        time.sleep(0.05)
+    print(" ".join(str(p) for p in pool._processes), flush=True)
+    time.sleep(120)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="reads /proc")
+def test_worker_processes_end_when_diagnose_is_killed(tmp_path):
+    """A parent killed by SIGKILL (or a SIGTERM it does not handle) leaves a process pool's workers running; diagnose's
+    workers watch for it and end within seconds. Control: a plain pool's workers, busy for two minutes, outlive it."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "pool.py"
+    script.write_text(_POOL_SCRIPT)
+
+    def orphans(kind: str) -> list[int]:
+        parent = subprocess.Popen([sys.executable, str(script), kind], stdout=subprocess.PIPE, text=True)
+        workers = [int(p) for p in parent.stdout.readline().split()]
+        assert len(workers) == 2, workers
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline and any(_alive(p) for p in workers):
+            time.sleep(0.2)
+        return [p for p in workers if _alive(p)]
+
+    assert orphans("fits") == []
+    left = orphans("plain")
+    try:
+        assert left, "the control's workers ended with their parent: the test cannot see the difference"
+    finally:
+        for pid in left:
+            os.kill(pid, signal.SIGKILL)

@@ -13,6 +13,8 @@ fresh worker would not know the file).
 from __future__ import annotations
 
 import multiprocessing
+import os
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Iterator
 
@@ -35,12 +37,20 @@ ELPD_DRAWS = 2000
 POSTERIOR_METHODS = ("laplace", "emcee")
 
 
-def _build(data, model, observables, priors):
-    """The posterior of ``model`` with those prior overrides that name its parameters (or nuisances)."""
-    probe = Posterior.build(data, model, observables=observables)
+def model_key(model) -> tuple:
+    """What identifies a model among diagnose's candidates (its ``searched`` maxima, the posteriors kept): its
+    effects in order and its wavelengths."""
+    return model.name, tuple(getattr(model, "wavelengths", ()))
+
+
+def _build(data, model, observables, priors, check: bool = True):
+    """The posterior of ``model`` with those prior overrides that name its parameters (or nuisances); ``check``:
+    ``Posterior.build``'s (False: its likelihood is compiled at first use, ``Posterior.ensure_checked``)."""
+    probe = Posterior.build(data, model, observables=observables, check=False)
     own = {p.name for p in probe.priors.parameters}
     overrides = {k: v for k, v in (priors or {}).items() if k in own}
-    return Posterior.build(data, model, overrides, observables=observables) if overrides else probe
+    post = Posterior.build(data, model, overrides, observables=observables, check=False) if overrides else probe
+    return post.ensure_checked() if check else post
 
 
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
@@ -76,7 +86,8 @@ TASKS = {"screen": _screen, "leader": _leader, "refit": fit_for_elpd}
 _WORKER: dict = {}  # in a worker process: the data and the fitting settings, sent once
 
 
-def _start_worker(data, observables, priors, small_calls: bool | None) -> None:
+def _start_worker(data, observables, priors, small_calls: bool | None, parent: int) -> None:
+    _exit_with_parent(parent)
     if small_calls is not None:  # the settings the calling process chose (None: it chose none)
         from .._runtime import configure_process
 
@@ -84,8 +95,28 @@ def _start_worker(data, observables, priors, small_calls: bool | None) -> None:
     _WORKER.update(data=data, observables=observables, priors=priors)
 
 
+def _exit_with_parent(parent: int, every_s: float = 1.0) -> None:
+    """A worker ends when the process that started it (``parent``, its pid as the parent saw it: a parent killed
+    while the worker was still starting is gone already when it looks) is gone: a pool's workers outlive a parent
+    killed by a signal it cannot handle (SIGTERM, SIGKILL), and went on refitting candidates for minutes with nobody
+    to read them."""
+    import threading
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(every_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="spacepol-parent-watch", daemon=True).start()
+
+
 def _in_worker(kind: str, model, args: tuple):
-    post = _build(_WORKER["data"], model, _WORKER["observables"], _WORKER["priors"])
+    # a model's posterior is kept for the worker's later tasks (its leader search and refit, a later round's
+    # screening of the same model): each new one compiles its likelihood again
+    posteriors = _WORKER.setdefault("posteriors", {})
+    if model_key(model) not in posteriors:
+        posteriors[model_key(model)] = _build(_WORKER["data"], model, _WORKER["observables"], _WORKER["priors"])
+    post = posteriors[model_key(model)]
     out = TASKS[kind](post, *args)
     if kind == "refit":
         out.posterior = None  # not picklable; the caller's own posterior replaces it
@@ -101,10 +132,17 @@ class CandidateFits:
         self.data, self.observables, self.priors = data, observables, priors
         self.workers = max(1, int(workers))
         self._pool = None
+        self._posteriors: dict = {}  # by ``model_key``
 
     def posterior(self, model) -> Posterior:
-        """The candidate's posterior in this process."""
-        return _build(self.data, model, self.observables, self.priors)
+        """The candidate's posterior in this process, kept for later calls (a later round changes back to a model
+        of an earlier one). Not checked (``Posterior.ensure_checked``) until a task runs in this process: the check
+        compiles its likelihood (1.2-4 s for a full-Mueller model on PTFE), which a worker process compiles again,
+        and a candidate whose maximum is known already may never be evaluated here at all."""
+        key = model_key(model)
+        if key not in self._posteriors:
+            self._posteriors[key] = _build(self.data, model, self.observables, self.priors, check=False)
+        return self._posteriors[key]
 
     def run(self, kind: str, jobs: list[tuple], rng: np.random.Generator) -> Iterator[tuple[int, object]]:
         """(index, result) per job, as jobs finish; a job is (model, posterior in this process, args...) and gets a
@@ -113,7 +151,7 @@ class CandidateFits:
         parallel = self.workers > 1 and len(jobs) > 1 and not any(_from_a_file(job[0]) for job in jobs)
         if not parallel:
             for i, (job, seed) in enumerate(zip(jobs, seeds)):
-                yield i, TASKS[kind](job[1], *_with_seed(kind, job[2:], seed))
+                yield i, TASKS[kind](job[1].ensure_checked(), *_with_seed(kind, job[2:], seed))
             return
         pool = self._open()
         futures = {pool.submit(_in_worker, kind, job[0], _with_seed(kind, job[2:], seed)): i
@@ -135,7 +173,7 @@ class CandidateFits:
 
             self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
                                              initializer=_start_worker,
-                                             initargs=(self.data, self.observables, self.priors, configured()))
+                                             initargs=(self.data, self.observables, self.priors, configured(), os.getpid()))
         return self._pool
 
     def close(self) -> None:

@@ -33,7 +33,7 @@ from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
-from .candidate_fits import CandidateFits, _build, fit_for_elpd
+from .candidate_fits import CandidateFits, fit_for_elpd, model_key
 from .changes import changes, separating_measurement
 from .records import CandidateFit, DiagnosisRecord
 
@@ -55,11 +55,6 @@ def check_prior_names(data, model: Model, priors: dict, observables=None, candid
 def _global_optimum(posterior, rng, budget, seeds=None):
     value, theta = find_optimum(posterior, rng, evaluations=budget, seeds=seeds)
     return value, dict(zip(posterior.priors.names, theta))
-
-
-def model_key(model: Model) -> tuple:
-    """What identifies a model for ``diagnose``'s ``searched``: its effects in order and its wavelengths."""
-    return model.name, tuple(getattr(model, "wavelengths", ()))
 
 
 def _vector(values: dict, posterior) -> np.ndarray:
@@ -96,7 +91,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     searched = {} if searched is None else searched
-    base_post = _build(data, model, observables, priors)
+    base_post = fits.posterior(model).ensure_checked()
     if model_key(model) not in searched:
         searched[model_key(model)] = _global_optimum(base_post, rng, screening_evaluations)
     base_best, base_optimum = searched[model_key(model)]

@@ -31,11 +31,13 @@ class Posterior:
 
     @classmethod
     def build(cls, data, model, prior_overrides=None, observables=None, robust=False, where="priors",
-              noise_floor: bool = True):
+              noise_floor: bool = True, check: bool = True):
         """Likelihood and priors of ``model`` on ``data``. Where the data measure their own noise (reciprocal
         pairs, repeated geometries: ``measured_noise``), an inferred noise level's prior starts at the measured
         level's floor, so that no fit claims less noise than the measurement shows (``noise_floor=False``
-        keeps the default priors; a prior file's own prior for the level always wins)."""
+        keeps the default priors; a prior file's own prior for the level always wins). ``check``: run
+        ``check_support`` now (it compiles the likelihood); without it, ``ensure_checked`` runs it before first use
+        (a process that only reads the priors, while another process evaluates the posterior, compiles nothing)."""
         likelihood = Likelihood(data, model, observables=observables, robust=robust)
         measured = measure(likelihood)
         nuisance = [_floored(p, measured[p.name]) if noise_floor and p.name in measured and p.name not in (prior_overrides or {})
@@ -43,8 +45,19 @@ class Posterior:
         priors = PriorSet(model.parameters + nuisance, prior_overrides, where=where)
         posterior = cls(likelihood, priors)
         posterior.measured_noise = measured
-        posterior.check_support(where)
+        posterior._where = where
+        if check:
+            posterior.check_support(where)
         return posterior
+
+    _checked = False
+    _where = "priors"
+
+    def ensure_checked(self) -> "Posterior":
+        """``check_support`` once (a posterior built with ``check=False``); returns the posterior."""
+        if not self._checked:
+            self.check_support(self._where)
+        return self
 
     def check_support(self, where: str = "priors", draws: int = 255) -> None:
         """Before any sampling: plug-in effects give finite predictions, and the posterior is finite
@@ -58,13 +71,13 @@ class Posterior:
         lp = self.priors.ln_prob(theta)
         if not np.any(np.isfinite(lp)):
             raise ParameterError(f"{where}: the prior density is zero at every one of {len(theta)} draws from it")
-        if self.prior_only:
-            return
-        ll = self.likelihood.total(self.priors.to_params(theta))
-        if not np.any(np.isfinite(ll)):
-            raise ParameterError(
-                f"{self.likelihood.data.source}: the likelihood is not finite at any of {len(theta)} draws from the "
-                f"priors ({where}); the model cannot produce these data anywhere the priors allow")
+        if not self.prior_only:
+            ll = self.likelihood.total(self.priors.to_params(theta))
+            if not np.any(np.isfinite(ll)):
+                raise ParameterError(
+                    f"{self.likelihood.data.source}: the likelihood is not finite at any of {len(theta)} draws from the "
+                    f"priors ({where}); the model cannot produce these data anywhere the priors allow")
+        self._checked = True
 
     @property
     def ndim(self) -> int:

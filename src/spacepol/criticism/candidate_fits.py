@@ -83,6 +83,7 @@ def _leader(post, seed: int) -> tuple[float, np.ndarray]:
 
 TASKS = {"screen": _screen, "leader": _leader, "refit": fit_for_elpd}
 
+_WORKER_KEEPS = 4  # posteriors a worker keeps
 _WORKER: dict = {}  # in a worker process: the data and the fitting settings, sent once
 
 
@@ -111,12 +112,15 @@ def _exit_with_parent(parent: int, every_s: float = 1.0) -> None:
 
 
 def _in_worker(kind: str, model, args: tuple):
-    # a model's posterior is kept for the worker's later tasks (its leader search and refit, a later round's
-    # screening of the same model): each new one compiles its likelihood again
+    # the last few models' posteriors are kept for their next tasks (a candidate's leader search and refit follow its
+    # screening): each new one compiles its likelihood again; a few only, as every compiled one kept slows the process
     posteriors = _WORKER.setdefault("posteriors", {})
-    if model_key(model) not in posteriors:
-        posteriors[model_key(model)] = _build(_WORKER["data"], model, _WORKER["observables"], _WORKER["priors"])
-    post = posteriors[model_key(model)]
+    key = model_key(model)
+    if key not in posteriors:
+        posteriors[key] = _build(_WORKER["data"], model, _WORKER["observables"], _WORKER["priors"])
+        while len(posteriors) > _WORKER_KEEPS:
+            posteriors.pop(next(iter(posteriors)))
+    post = posteriors[key]
     out = TASKS[kind](post, *args)
     if kind == "refit":
         out.posterior = None  # not picklable; the caller's own posterior replaces it
@@ -132,17 +136,14 @@ class CandidateFits:
         self.data, self.observables, self.priors = data, observables, priors
         self.workers = max(1, int(workers))
         self._pool = None
-        self._posteriors: dict = {}  # by ``model_key``
 
     def posterior(self, model) -> Posterior:
-        """The candidate's posterior in this process, kept for later calls (a later round changes back to a model
-        of an earlier one). Not checked (``Posterior.ensure_checked``) until a task runs in this process: the check
-        compiles its likelihood (1.2-4 s for a full-Mueller model on PTFE), which a worker process compiles again,
-        and a candidate whose maximum is known already may never be evaluated here at all."""
-        key = model_key(model)
-        if key not in self._posteriors:
-            self._posteriors[key] = _build(self.data, model, self.observables, self.priors, check=False)
-        return self._posteriors[key]
+        """The candidate's posterior in this process, not checked (``Posterior.ensure_checked``) until a task runs
+        here: the check compiles its likelihood (1.2-4 s for a full-Mueller model on PTFE), which a worker process
+        compiles again, and a candidate whose maximum is known already may never be evaluated here at all. Not kept
+        either: 61 compiled candidate posteriors held in one process made every later evaluation 1.3x slower
+        (Python's collector walking twice the objects), more than their compilations would cost again."""
+        return _build(self.data, model, self.observables, self.priors, check=False)
 
     def run(self, kind: str, jobs: list[tuple], rng: np.random.Generator) -> Iterator[tuple[int, object]]:
         """(index, result) per job, as jobs finish; a job is (model, posterior in this process, args...) and gets a

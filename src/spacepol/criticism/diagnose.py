@@ -91,7 +91,10 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     check_prior_names(data, model, priors, observables, candidates)
     clock = {"start": time.perf_counter()}
     searched = {} if searched is None else searched
-    base_post = fits.posterior(model).ensure_checked()
+    base_post = fits.posterior(model)
+    if _same_posterior(base, base_post):  # compiled already (diagnose --rounds: the last round's lead)
+        base_post = base.posterior
+    base_post.ensure_checked()
     if model_key(model) not in searched:
         searched[model_key(model)] = _global_optimum(base_post, rng, screening_evaluations)
     base_best, base_optimum = searched[model_key(model)]
@@ -255,6 +258,17 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)}},
                            base, confirmed)
+
+
+def _same_posterior(result, posterior) -> bool:
+    """Whether ``result`` (a Result or None) holds ``posterior`` itself: the same data object, model, observables and
+    priors (a user's own run of the model, with its own priors or data, does not count)."""
+    own = getattr(result, "posterior", None)
+    if own is None:
+        return False
+    a, b = own.likelihood, posterior.likelihood
+    return (a.data is b.data and model_key(a.model) == model_key(b.model) and a.observables == b.observables
+            and own.priors.describe() == posterior.priors.describe())
 
 
 def posterior_quality(inv) -> dict:

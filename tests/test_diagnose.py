@@ -296,3 +296,27 @@ def test_worker_processes_end_when_diagnose_is_killed(tmp_path):
     finally:
         for pid in left:
             os.kill(pid, signal.SIGKILL)
+
+
+def test_the_next_rounds_base_reuses_the_last_leads_posterior_only_when_it_is_the_same():
+    """diagnose takes the base Result's own posterior (compiled already) when it is the posterior diagnose would
+    build: same data object, model, observables and priors. Controls: the same model on a copy of the data, and
+    with another prior, are not taken."""
+    from types import SimpleNamespace
+
+    from spacepol.criticism.candidate_fits import CandidateFits
+    from spacepol.criticism.diagnose import _same_posterior
+    from spacepol.io import read_measurements
+    from spacepol.paths import bundled
+    from spacepol.physics import Model
+    from spacepol.priors import Uniform
+
+    data = read_measurements(bundled("synthetic", "hidden_effect.csv"))
+    model = Model.from_string("paper")
+    fits = CandidateFits(data)
+    lead = SimpleNamespace(posterior=fits.posterior(model))
+    assert _same_posterior(lead, fits.posterior(model))
+    assert not _same_posterior(None, fits.posterior(model))
+    assert not _same_posterior(lead, CandidateFits(data.select(np.arange(len(data)))).posterior(model))
+    assert not _same_posterior(lead, CandidateFits(data, priors={"n": Uniform(1.2, 2.0)}).posterior(model))
+    assert not _same_posterior(lead, fits.posterior(Model.from_string("paper+lambertian")))

@@ -50,14 +50,12 @@ def loo(idata) -> dict:
         log_weights, k = psis_log_weights(-ll, reff)
         pointwise = logsumexp_rows(log_weights + ll)
         lppd = float(np.sum(logsumexp_rows(ll) - np.log(n_samples)))
-    k = np.asarray(k, float).copy()
     p_loo = lppd - float(pointwise.sum())
     failed = ~np.isfinite(pointwise)
     if failed.any():
         # PSIS breaks down (NaN) where one observation's log-likelihood spans hundreds of units across the
         # draws: take its in-sample log predictive density instead (an overestimate of its ELPD) and flag
         # it as a bad Pareto k, so the report says LOO is unreliable there
-        pointwise = pointwise.copy()
         pointwise[failed] = logsumexp_rows(ll[failed]) - np.log(n_samples)
         k[failed] = np.inf
     return loo_fields(pointwise, k, p_loo, idata.log_likelihood["obs_id"].values)

@@ -329,3 +329,58 @@ def test_the_next_rounds_base_reuses_the_last_leads_posterior_only_when_it_is_th
     assert not _same_posterior(lead, CandidateFits(data.select(np.arange(len(data)))).posterior(model))
     assert not _same_posterior(lead, CandidateFits(data, priors={"n": Uniform(1.2, 2.0)}).posterior(model))
     assert not _same_posterior(lead, fits.posterior(Model.from_string("paper+lambertian")))
+
+
+def test_a_candidate_clearly_worse_than_the_refitted_leader_is_not_refitted(monkeypatch):
+    """diagnose refits the best-screened candidate first; a candidate whose log likelihood at its own optimum falls
+    below that refit's pointwise ELPD-LOO by more than 2 SE (widened) and a margin for its LOO correction is not
+    refitted, and its ranking entry says against whom and by how much. Control: with the rule off it is refitted,
+    and its refitted ELPD-LOO is indeed significantly below the leader's (the skip lost nothing), with the same
+    verdict. (A candidate near the leader: ``test_dominance_needs_a_gap_beyond_its_standard_error_and_margin``.)"""
+    from spacepol.criticism import diagnose as dg
+    from spacepol.criticism.hidden_effects import suite
+
+    case = next(c for c in suite() if c.effect == "polarized_diffuse")
+    report = _case_report(case, candidates=["polarized_diffuse", "lambertian", "dop_bias"], top=3)
+    assert report["verdict"] == "polarized_diffuse"
+    skipped = [e for e in report["ranking"] if e.get("dominated_by")]
+    assert skipped, [(e["change"], e["delta_elpd"]) for e in report["ranking"]]
+    for e in skipped:
+        assert e["delta_elpd"] is None and e["dominated_by"] == "add polarized_diffuse"
+        assert e["explanation"].startswith("Not refitted") and e["delta_to_leader"] < -2 * e["delta_to_leader_se"]
+    monkeypatch.setattr(dg, "_dominated", lambda *a: False)
+    control = _case_report(case, candidates=["polarized_diffuse", "lambertian", "dop_bias"], top=3)
+    assert control["verdict"] == report["verdict"]
+    by_change = {e["change"]: e for e in control["ranking"]}
+    fitted = {c.label: c for c in control.confirmed}
+    for e in skipped:
+        assert by_change[e["change"]]["delta_elpd"] is not None
+        gap = fitted["add polarized_diffuse"].pointwise - fitted[e["change"]].pointwise  # refitted ELPD-LOO, pointwise
+        se = float(np.sqrt(len(gap) * np.var(gap)))
+        assert gap.sum() > 2 * se and gap.sum() > 4, (e["change"], gap.sum(), se)
+        assert gap.sum() > -e["delta_to_leader"]  # the plug-in gap understates the refitted one
+
+
+def test_dominance_needs_a_gap_beyond_its_standard_error_and_margin():
+    """``_dominated``'s arithmetic on a stub: a leader 60 above a 3-parameter candidate's plug-in pointwise log
+    likelihood over 400 numbers (SE ~ 4) dominates it; 10 above with the same scatter does not (10 - 6 < 2 x 1.25 x
+    SE), nor does 60 spread so widely that its SE is 40."""
+    from types import SimpleNamespace
+
+    from spacepol.criticism.diagnose import _dominated
+
+    rng = np.random.default_rng(0)
+    plug_in = rng.normal(size=400)
+    posterior = SimpleNamespace(ndim=3, log_prob_pointwise=lambda theta: plug_in[None, :])
+
+    def candidate():
+        return SimpleNamespace(posterior=posterior, optimum=np.zeros(3), dominance_delta=None)
+
+    def leader(offset, scatter):
+        noise = rng.normal(size=400)
+        return SimpleNamespace(pointwise=plug_in + offset / 400 + scatter * (noise - noise.mean()) / noise.std())
+
+    clear = candidate()
+    assert _dominated(clear, leader(60.0, 0.2)) and clear.dominance_delta == pytest.approx(60.0)
+    assert not _dominated(candidate(), leader(10.0, 0.2))
+    assert not _dominated(candidate(), leader(60.0, 2.0))

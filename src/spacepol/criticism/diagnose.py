@@ -165,26 +165,51 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     if progress and to_confirm:
         _say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c.label for c in to_confirm)} "
              f"({time.perf_counter() - clock['start']:.0f} s)")
-    # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found
-    jobs = [(c.model, c.posterior, c.optimum, seed, max_steps, posterior_method) for c in to_confirm]
-    refits = {}
-    for i, inv in fits.run("refit", jobs, rng):
-        refits[i] = inv
-        if progress:
-            q = posterior_quality(inv)
-            how = ("Laplace-IS" if q["engine"] == "laplace-is" else "emcee (the Laplace approximation was not trusted)"
-                   + ("" if q["converged"] else f", which {_unconverged(q)}"))
-            _say(f"[confirm {len(refits)}/{len(to_confirm)}] {to_confirm[i].label}: {how}, "
-                 f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
-    confirmed = []
-    for i, c in enumerate(to_confirm):
-        inv = refits[i]
-        diff = inv.loo["pointwise"] - base_loo
-        c.inversion, c.pointwise = inv, inv.loo["pointwise"]
-        c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
-        c.rmse_dop_after, c.signatures = inv.summary["fit"]["rmse_dop"], signatures(base, inv, base_fit)
-        c.significant = significant(c.delta_elpd, c.delta_elpd_se)
-        confirmed.append(c)
+    # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found; the
+    # best screened first, so that candidates its refit shows to be clearly worse need no refit of their own
+    to_confirm.sort(key=lambda c: -c.screening_gain)
+    refitted, dominated = [], []
+
+    def refit(batch: list) -> None:
+        jobs = [(c.model, c.posterior, c.optimum, seed, max_steps, posterior_method) for c in batch]
+        for i, inv in fits.run("refit", jobs, rng):
+            c = batch[i]
+            diff = inv.loo["pointwise"] - base_loo
+            c.inversion, c.pointwise = inv, inv.loo["pointwise"]
+            c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
+            c.rmse_dop_after, c.signatures = inv.summary["fit"]["rmse_dop"], signatures(base, inv, base_fit)
+            c.significant = significant(c.delta_elpd, c.delta_elpd_se)
+            refitted.append(c)
+            if progress:
+                q = posterior_quality(inv)
+                how = ("Laplace-IS" if q["engine"] == "laplace-is" else "emcee (the Laplace approximation was not trusted)"
+                       + ("" if q["converged"] else f", which {_unconverged(q)}"))
+                _say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {c.label}: {how}, "
+                     f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
+
+    def weigh(pending: list) -> list:
+        """``pending`` less those the best refit so far shows clearly worse (``_dominated``; not the changes asked for)."""
+        lead = _front_runner(refitted) if criterion == "loo" else None
+        skip = [c for c in pending if lead is not None and c.label not in confirm and _dominated(c, lead)]
+        if progress and skip:
+            _say(f"[confirm] not refitted, clearly worse than {lead.label}: {', '.join(c.label for c in skip)}")
+        dominated.extend(skip)
+        return [c for c in pending if c not in skip]
+
+    # the best screened alone first, then the rest at once (so the refits do not depend on the number of workers);
+    # every skip is weighed again against the final front-runner, the one a tie would be judged against
+    refit(to_confirm[:1])
+    refit(weigh(to_confirm[1:]))
+    while dominated:
+        again = [c for c in dominated if _front_runner(refitted) is None or not _dominated(c, _front_runner(refitted))]
+        if not again:
+            break
+        dominated[:] = [c for c in dominated if c not in again]
+        refit(again)
+    for c in dominated:
+        c.dominated_by = _front_runner(refitted).label
+    to_confirm = [c for c in to_confirm if c not in dominated]
+    confirmed = [c for c in to_confirm]
     base_evidence = evidence_of(base, base_post, seed) if criterion == "evidence" else base.log_evidence
     for c in confirmed:
         own = evidence_of(c.inversion, c.posterior, seed) if criterion == "evidence" else c.inversion.log_evidence
@@ -225,6 +250,12 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry = {"effect": c.effect, "change": c.label, "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
                  "significant": False, "screening_gain": c.screening_gain,
                  "explanation": f"Screened out: its best fit gains only {c.screening_gain:.1f} in log posterior."}
+        if c.dominated_by is not None:
+            entry.update(dominated_by=c.dominated_by, delta_to_leader=-c.dominance_delta,
+                         delta_to_leader_se=c.dominance_se, explanation=(
+                f"Not refitted: its log likelihood at its best optimum (screening gain {c.screening_gain:.1f}) falls "
+                f"below the refitted ELPD-LOO of '{c.dominated_by}' by {c.dominance_delta:.1f} +- {c.dominance_se:.1f}, "
+                f"beyond 2 SE and any LOO correction ({c.dominance_margin:.0f}): it can neither lead nor tie."))
         if c.plugin_delta is not None:
             entry.update(plugin_delta=c.plugin_delta, plugin_se=c.plugin_se, explanation=(
                 f"Not refitted: at the two optima its log likelihood differs from the model's by {c.plugin_delta:+.1f} "
@@ -304,6 +335,31 @@ def _plugin_decides(c: CandidateFit, base_pointwise: np.ndarray, base_p_loo: flo
     margin = base_p_loo + 2.0 * c.posterior.ndim
     if abs(delta) - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
         c.plugin_delta, c.plugin_se, c.plugin_margin = delta, se, margin
+        return True
+    return False
+
+
+def _front_runner(refitted: list):
+    """The refitted candidate a skipped one is weighed against: the best by ELPD-LOO, provided it is significant and
+    its posterior converged (else None: an unconverged refit's ELPD is less certain than its SE says)."""
+    best = max(refitted, key=lambda c: c.delta_elpd, default=None)
+    if best is None or not best.significant or not posterior_quality(best.inversion)["converged"]:
+        return None
+    return best
+
+
+def _dominated(c: CandidateFit, lead: CandidateFit) -> bool:
+    """Whether candidate ``c`` is so clearly worse than the refitted ``lead`` that its refit could neither make it
+    lead nor tie: the lead's pointwise ELPD-LOO minus c's pointwise log likelihood at its optimum sums to d with
+    standard error s, and d - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = 2 x c's free parameters.
+    The plug-in log likelihood stands above c's ELPD-LOO (by about its p_loo plus half its free parameters), so d
+    understates how much worse c predicts. Its refit starts at the same optimum, so it would weigh the same mode.
+    Records the figures in ``c`` when it decides."""
+    d = lead.pointwise - c.posterior.log_prob_pointwise(c.optimum[None, :])[0]
+    delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
+    margin = 2.0 * c.posterior.ndim
+    if delta - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
+        c.dominance_delta, c.dominance_se, c.dominance_margin = delta, se, margin
         return True
     return False
 

@@ -35,7 +35,8 @@ class CandidateFit:
     """One change of a model as diagnose weighs it: the change (``criticism.changes.Change``), its posterior,
     its screening gain (max log posterior over the base model's) and optimum, and once refitted its Result
     (``inversion``), pointwise ELPD-LOO, the differences to the base (ELPD-LOO, ln Z) and its signatures; where its
-    optimum alone decides (``plugin_delta``) the plug-in log-likelihood difference instead."""
+    optimum alone decides (``plugin_delta``) the plug-in log-likelihood difference instead; where a better refitted
+    candidate's ELPD-LOO shows it clearly worse (``dominated_by``) that difference instead."""
 
     change: object
     posterior: object
@@ -53,6 +54,10 @@ class CandidateFit:
     plugin_delta: float | None = None
     plugin_se: float | None = None
     plugin_margin: float | None = None
+    dominated_by: str | None = None
+    dominance_delta: float | None = None
+    dominance_se: float | None = None
+    dominance_margin: float | None = None
 
     @property
     def effect(self) -> str:

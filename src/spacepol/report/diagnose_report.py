@@ -53,9 +53,13 @@ def significance_statement(report: dict) -> str:
     confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]
     yes = [f"{_name(r)} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if r["significant"]]
     no = [f"{_name(r)} ({r['delta_elpd']:+.1f} +- {r['delta_elpd_se']:.1f})" for r in confirmed if not r["significant"]]
-    screened = [_name(r) for r in report["ranking"] if r["delta_elpd"] is None]
+    screened = [_name(r) for r in report["ranking"] if r["delta_elpd"] is None and not r.get("dominated_by")]
+    worse = [f"{_name(r)} ({r['delta_to_leader']:+.1f} +- {r['delta_to_leader_se']:.1f} below {r['dominated_by']})"
+             for r in report["ranking"] if r["delta_elpd"] is None and r.get("dominated_by")]
     text = ("Improve ELPD-LOO by more than 2 SE: " + (", ".join(yes) if yes else "none") + ". Do not: "
             + (", ".join(no) if no else "none of the refitted candidates"))
+    if worse:
+        text += "; not refitted, clearly worse than a refitted change at their own optimum: " + ", ".join(worse)
     if screened:
         text += "; screened out before refitting (their best fit gains too little): " + ", ".join(screened)
     return text + "."
@@ -86,7 +90,8 @@ def write_diagnose_report(report: dict, base, confirmed: list, out: Path, data_l
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
         ("Ranking", H.table(["change", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
                              "significant (> 2 SE and > 4)"], ranking_rows(report))
-         + H.bullets([f"{_name(r)}: {r['explanation']}" for r in report["ranking"] if r["delta_elpd"] is not None])),
+         + H.bullets([f"{_name(r)}: {r['explanation']}" for r in report["ranking"]
+                      if r["delta_elpd"] is not None or r.get("dominated_by")])),
         ("Signatures", H.image(H.png_file_to_data_uri(paths["signatures"]),
                                "Dots: residuals of the base fit / noise. Crosses: what each candidate changes in the "
                                "prediction, in the same units. A candidate that explains the misfit follows the dots.")),

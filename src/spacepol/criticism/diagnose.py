@@ -25,6 +25,7 @@ import time
 import numpy as np
 
 from ..errors import SpacepolError
+from ..infer import elpd_settled
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
@@ -305,17 +306,20 @@ def _same_posterior(result, posterior) -> bool:
 def posterior_quality(inv) -> dict:
     """How a refit's posterior was obtained and whether it can be trusted (``Result.diagnostics``): the engine
     (laplace-is: trusted weights by construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for,
-    else not converged within its cap)."""
+    else not converged within its cap, or ``stopped_early`` where its ELPD-LOO had settled: ``elpd_settled``)."""
     d = inv.diagnostics
     if d.engine == "laplace-is":
         return {"engine": d.engine, "converged": True, "pareto_k": d.pareto_k, "effective_draws": d.ess_min}
-    return {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps}
+    return {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps,
+            "stopped_early": bool(inv.summary.get("sampler", {}).get("stopped_early", False))}
 
 
 def _unconverged(quality: dict) -> str:
     """``posterior_quality``'s figures for a chain that stopped short of its targets, in words."""
-    return (f"did not converge ({quality['steps']} emcee steps, R-hat {quality['rhat_max']:.3f}, "
-            f"ESS {quality['ess_min']:.0f})")
+    text = f"did not converge ({quality['steps']} emcee steps, R-hat {quality['rhat_max']:.3f}, ESS {quality['ess_min']:.0f}"
+    if quality.get("stopped_early"):
+        text += f"; stopped where its two halves' ELPD-LOO agreed within {elpd_settled.TOLERANCE:g}"
+    return text + ")"
 
 
 # the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it
@@ -352,8 +356,9 @@ def _dominated(c: CandidateFit, lead: CandidateFit) -> bool:
     """Whether candidate ``c`` is so clearly worse than the refitted ``lead`` that its refit could neither make it
     lead nor tie: the lead's pointwise ELPD-LOO minus c's pointwise log likelihood at its optimum sums to d with
     standard error s, and d - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = 2 x c's free parameters.
-    The plug-in log likelihood stands above c's ELPD-LOO (by about its p_loo plus half its free parameters), so d
-    understates how much worse c predicts. Its refit starts at the same optimum, so it would weigh the same mode.
+    The plug-in log likelihood stands above c's ELPD-LOO (by about its effective number of parameters, p_loo, for a
+    regular posterior), so d understates how much worse c predicts; the margin covers a posterior whose LOO density
+    exceeds its plug-in one. Its refit starts at the same optimum, so it would weigh the same mode.
     Records the figures in ``c`` when it decides."""
     d = lead.pointwise - c.posterior.log_prob_pointwise(c.optimum[None, :])[0]
     delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))

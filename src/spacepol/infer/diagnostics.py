@@ -40,11 +40,22 @@ def loo(idata) -> dict:
     predictive density stands in and its Pareto k is set to inf."""
     ll = idata.log_likelihood["y"].transpose("obs_id", "chain", "draw").values
     ll = ll.reshape(ll.shape[0], -1)  # (M, S): ArviZ's stacking of (chain, draw)
+    reff = relative_efficiency(idata.posterior, ll.shape[1]) if len(idata.posterior.chain) > 1 else 1.0
+    pointwise, k, p_loo = psis_loo(ll, reff)
+    return loo_fields(pointwise, k, p_loo, idata.log_likelihood["obs_id"].values)
+
+
+def relative_efficiency(posterior, n_samples: int) -> float:
+    """ArviZ's relative efficiency of ``n_samples`` draws taken from a posterior's (an xarray Dataset, chains x
+    draws): the mean ESS of its parameters over ``n_samples``, as ``arviz.loo`` computes it."""
+    ess_p = az.ess(posterior, method="mean")
+    return float(np.hstack([ess_p[v].values.flatten() for v in ess_p.data_vars]).mean() / n_samples)
+
+
+def psis_loo(ll: np.ndarray, reff: float = 1.0) -> tuple[np.ndarray, np.ndarray, float]:
+    """(pointwise ELPD-LOO, Pareto k, p_loo) of log likelihoods ``ll`` (observations, draws), as ``loo`` computes
+    them."""
     n_samples = ll.shape[1]
-    reff = 1.0
-    if len(idata.posterior.chain) > 1:
-        ess_p = az.ess(idata.posterior, method="mean")
-        reff = float(np.hstack([ess_p[v].values.flatten() for v in ess_p.data_vars]).mean() / n_samples)
     with warnings.catch_warnings(), np.errstate(invalid="ignore", over="ignore"):
         warnings.simplefilter("ignore")
         log_weights, k = psis_log_weights(-ll, reff)
@@ -58,7 +69,7 @@ def loo(idata) -> dict:
         # it as a bad Pareto k, so the report says LOO is unreliable there
         pointwise[failed] = logsumexp_rows(ll[failed]) - np.log(n_samples)
         k[failed] = np.inf
-    return loo_fields(pointwise, k, p_loo, idata.log_likelihood["obs_id"].values)
+    return pointwise, k, p_loo
 
 
 PARETO_K_LIMIT = 0.7  # above it an importance-sampling estimate is unreliable (Vehtari et al., JMLR 25(72), 2024)

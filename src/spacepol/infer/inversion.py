@@ -15,6 +15,7 @@ from ..observables import registry
 from ..physics.model_spec import spec_of
 from .chain_file import chain_iterations, compact
 from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
+from .elpd_settled import settled
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
 from .inference_data import batched, to_inference_data
@@ -72,12 +73,14 @@ def check_walkers(walkers: int | None, ndim: int) -> int:
 
 def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_steps: int = 20000,
            backend_path=None, progress: bool = True, check_every: int = 500, centre=None, space=None,
-           tau_multiple: float = 50.0, max_pointwise_draws: int | None = None) -> Result:
+           tau_multiple: float = 50.0, max_pointwise_draws: int | None = None, elpd_tolerance: float | None = None) -> Result:
     """emcee posterior and its summary. ``centre``: a parameter vector (e.g. an optimum already found)
     around which the walkers start; by default a global optimisation finds one. ``space``: where the walkers
     move (``sampling_space``; default the logit of each prior's CDF). ``tau_multiple``: the chain is long
     enough at this many autocorrelation times (with R-hat <= 1.01 and ESS >= 400 besides).
-    ``max_pointwise_draws``: PSIS-LOO and the posterior predictive from at most this many draws."""
+    ``max_pointwise_draws``: PSIS-LOO and the posterior predictive from at most this many draws. ``elpd_tolerance``:
+    for a caller that needs the ELPD-LOO alone (diagnose), the chain may stop before convergence where the ELPD-LOO
+    of its two halves agree within this many log units (``elpd_settled``; ``summary["sampler"]["stopped_early"]``)."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = check_walkers(walkers, posterior.ndim)
@@ -89,7 +92,8 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     result = sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, backend_path=backend_path,
                           progress=progress, model_name=posterior.likelihood.model.name, seed=seed,
                           check_every=check_every, space=space, tau_multiple=tau_multiple,
-                          initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng))
+                          initial=None if centre is None else ball(posterior, np.asarray(centre, float), walkers, rng),
+                          enough=None if elpd_tolerance is None else settled(posterior, elpd_tolerance))
     if backend_path is not None:
         compact(backend_path)
     idata = to_inference_data(result, posterior, rng, max_pointwise_draws)

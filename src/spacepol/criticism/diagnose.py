@@ -9,7 +9,9 @@
    likelihood-ratio statistic) ranks the candidates.
 3. Confirmation: the ``top`` candidates get a global multistart too, and are refitted (as M) from the better of
    the two optima; the change in ELPD-LOO and its
-   standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4.
+   standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4. The best screened is
+   refitted first; a candidate whose log likelihood at its own optimum falls clearly below that refit's ELPD-LOO
+   (``_dominated``) could neither lead nor tie, and is not refitted.
 4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
    explanation says what measurement separates them (as the effects declare it). Effects declared
    twins are always refitted together.

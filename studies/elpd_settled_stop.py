@@ -16,7 +16,6 @@ import time
 
 import numpy as np
 
-BASE = "paper+lambertian"
 MODELS = ("paper+lambertian+oxide_layer", "paper+lambertian+oxide_layer+ggx")
 
 
@@ -29,22 +28,15 @@ def main():
     from spacepol import configure_process
 
     configure_process(small_calls=True)
-    from spacepol.criticism.candidate_fits import ELPD_DRAWS, ELPD_TAU_MULTIPLE, _build, fit_for_elpd
+    from ridge_base import base_pointwise, ptfe_set
+    from spacepol.criticism.candidate_fits import ELPD_DRAWS, ELPD_TAU_MULTIPLE, _build
     from spacepol.infer import elpd_settled
     from spacepol.infer.inversion import invert
-    from spacepol.infer.measured_noise import reciprocal_pairs
     from spacepol.infer.optimum import multistart
-    from spacepol.io import read_measurements
-    from spacepol.paths import bundled
     from spacepol.physics import Model
 
-    first = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
-    rows = np.union1d(np.arange(0, len(first), max(1, len(first) // 260)), reciprocal_pairs(first).ravel())
-    data = first.select(rows)
-    base = _build(data, Model.from_string(BASE), None, None)
-    _, centre = multistart(base, np.random.default_rng(0))
-    base_loo = fit_for_elpd(base, centre, 0, 8000).loo["pointwise"]
-    print(f"{BASE}: ELPD-LOO {base_loo.sum():.1f} (Laplace-IS)", flush=True)
+    data = ptfe_set()
+    base_loo = base_pointwise(data)
     checks = []
     original = elpd_settled.settled
 

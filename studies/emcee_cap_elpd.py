@@ -18,7 +18,6 @@ import time
 import numpy as np
 
 STOPS = (2000, 4000, 8000, 16000)
-BASE = "paper+lambertian"
 MODELS = ("paper+lambertian+oxide_layer", "paper+lambertian+oxide_layer+ggx")
 
 
@@ -28,23 +27,16 @@ def main(models):
     configure_process(small_calls=True)
     import emcee
 
-    from spacepol.criticism.candidate_fits import _build, fit_for_elpd
+    from ridge_base import base_pointwise, ptfe_set
+    from spacepol.criticism.candidate_fits import _build
     from spacepol.infer.engines.emcee_sampler import _moves, _tau, ball, default_walkers, reaching_a_bound
-    from spacepol.infer.measured_noise import reciprocal_pairs
     from spacepol.infer.optimum import multistart
     from spacepol.infer.psis import logsumexp_rows, psis_log_weights
     from spacepol.infer.sampling_space import SamplingSpace
-    from spacepol.io import read_measurements
-    from spacepol.paths import bundled
     from spacepol.physics import Model
 
-    first = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
-    rows = np.union1d(np.arange(0, len(first), max(1, len(first) // 260)), reciprocal_pairs(first).ravel())
-    data = first.select(rows)
-    base = _build(data, Model.from_string(BASE), None, None)
-    _, centre = multistart(base, np.random.default_rng(0))
-    base_loo = fit_for_elpd(base, centre, 0, 8000).loo["pointwise"]
-    print(f"{BASE}: ELPD-LOO {base_loo.sum():.1f} (Laplace-IS)", flush=True)
+    data = ptfe_set()
+    base_loo = base_pointwise(data)
 
     def pointwise_loo(post, theta):
         ll = np.concatenate([post.log_prob_pointwise(theta[i : i + 256]) for i in range(0, len(theta), 256)]).T

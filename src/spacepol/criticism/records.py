@@ -36,7 +36,7 @@ class CandidateFit:
     its screening gain (max log posterior over the base model's) and optimum, and once refitted its Result
     (``inversion``), pointwise ELPD-LOO, the differences to the base (ELPD-LOO, ln Z) and its signatures; where its
     optimum alone decides (``plugin_delta``) the plug-in log-likelihood difference instead; where a better refitted
-    candidate's ELPD-LOO shows it clearly worse (``dominated_by``) that difference instead."""
+    candidate's ELPD-LOO shows it clearly worse (``dominated_by``) its gap to that candidate instead."""
 
     change: object
     posterior: object

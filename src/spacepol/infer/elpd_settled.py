@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from .diagnostics import PARETO_K_LIMIT, psis_loo, relative_efficiency
+from .inference_data import batched
 
 # the two halves' ELPD-LOO agree within this many log units: half of the smallest difference diagnose calls
 # significant (``diagnose.MIN_DELTA_ELPD``, 4)
@@ -39,8 +40,7 @@ def elpd_loo_of(posterior, chain: np.ndarray, draws: int = DRAWS_PER_HALF) -> tu
     steps, walkers, ndim = chain.shape
     kept = chain[:: max(1, int(np.ceil(steps * walkers / draws)))]
     flat = kept.reshape(-1, ndim)
-    batch = posterior.likelihood.batch_sets
-    ll = np.concatenate([posterior.log_prob_pointwise(flat[i : i + batch]) for i in range(0, len(flat), batch)]).T
+    ll = batched(posterior.log_prob_pointwise, flat, posterior.likelihood.batch_sets).T
     reff = 1.0
     if walkers > 1:
         dataset = xr.Dataset({f"p{j}": (("chain", "draw"), chain[:, :, j].T) for j in range(ndim)})

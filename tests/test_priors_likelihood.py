@@ -180,6 +180,11 @@ def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
     alone = [lik.total({k: v[i : i + 1] for k, v in sets.items()})[0] for i in (0, 17, 99)]
     np.testing.assert_allclose(totals[2][[0, 17, 99]], alone, rtol=1e-12)
     np.testing.assert_allclose(totals[1], totals[2][:40], rtol=1e-12)
+    # the pointwise values come from that same program (a model diagnose refits compiles one likelihood, not two),
+    # and the total is their sum; the fused total of the small likelihood (below) agrees with its pointwise sum too
+    pointwise = lik.pointwise({k: v[:40] for k, v in sets.items()})
+    assert pointwise.shape == (40, lik.n_obs) and len(lik._jitted) == 1
+    np.testing.assert_allclose(pointwise.sum(axis=1), totals[1], rtol=1e-12)
     small_model, small_data = _mueller_set(20)
     small = Likelihood(small_data, small_model, observables=["mueller"])
     assert not small.compiles_one_block
@@ -187,6 +192,9 @@ def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
         small.total({k: v[:m] for k, v in sets.items()})
     (key, jitted), = small._jitted.items()
     assert jitted._cache_size() == 3
+    few = {k: v[:5] for k, v in sets.items()}
+    np.testing.assert_allclose(small.pointwise(few).sum(axis=1), small.total(few), rtol=1e-12)
+    assert len(small._jitted) == 2  # negative control: the small likelihood's total is a program of its own
 
 
 def test_a_fixed_index_under_the_interface_equals_the_same_index_free():

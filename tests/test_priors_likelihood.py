@@ -185,6 +185,11 @@ def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
     pointwise = lik.pointwise({k: v[:40] for k, v in sets.items()})
     assert pointwise.shape == (40, lik.n_obs) and len(lik._jitted) == 1
     np.testing.assert_allclose(pointwise.sum(axis=1), totals[1], rtol=1e-12)
+    # a block too large for the unfused values to stay in the cache (1,024 sets x 4,800 numbers) is summed fused
+    lik.exact_sizes.add(1024)
+    many = {k: np.resize(v, 1024) for k, v in sets.items()}
+    np.testing.assert_allclose(lik.total(many)[:100], totals[2], rtol=1e-12)
+    assert len(lik._jitted) == 2
     small_model, small_data = _mueller_set(20)
     small = Likelihood(small_data, small_model, observables=["mueller"])
     assert not small.compiles_one_block

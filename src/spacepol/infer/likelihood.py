@@ -9,7 +9,8 @@ the order of ``observables``) is kept for PSIS-LOO.
 The log-likelihood is one compiled JAX function of the parameter sets: the model's evaluation, the
 observables' predictions, residuals and densities fused, so no Mueller matrix or residual array of
 sets x geometries is written to memory when only the sum per set is wanted (``total``, what the samplers
-and optimizers call).
+and optimizers call). On a large data set, whose calls take 16 sets at a time, the total is the pointwise
+program's sum instead: as fast there, and a model then compiles one likelihood program, not two.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ _ALWAYS_UP_TO = 256
 # 325 geometries x 16 elements: 6 sizes per model, ~27 s, of a diagnose candidate's ~40 s), while a call of 16 sets
 # takes milliseconds, so the fixed cost of more calls is lost in it
 _ONE_BLOCK_NUMBERS = 1 << 15
+# ``total`` reads a large likelihood's pointwise program where a call's block holds at most this many numbers: beyond
+# it the unfused values no longer stay in the cache (all of PTFE, 7,296 geometries x 16 elements, ``paper`` at four
+# wavelengths: 30 sets 0.78x the fused total's time, 64 sets 1.35x)
+_POINTWISE_NUMBERS = 4_000_000
 
 
 def _block_rows(n_sets: int, sizes: list) -> int:
@@ -195,11 +200,13 @@ class Likelihood:
 
     def total(self, params: dict) -> np.ndarray:
         """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept); on a
-        large data set (``compiles_one_block``) the sum of ``pointwise``, so that a model compiles one likelihood
-        program, not two (PTFE, 278 full-Mueller geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to
+        large data set (``compiles_one_block``), where a call's block holds at most ``_POINTWISE_NUMBERS`` numbers,
+        the sum of ``pointwise``, so that a model compiles one likelihood program, not two (PTFE, 278 full-Mueller geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to
         compile, and every model diagnose refits needs the pointwise one too)."""
         if self.compiles_one_block:
-            return self._call(0, params).sum(axis=-1)
+            n_sets = max((np.size(v) for v in params.values() if np.ndim(v)), default=0)
+            if _block_rows(n_sets, self._sizes()) * self.numbers_per_set <= _POINTWISE_NUMBERS:
+                return self._call(0, params).sum(axis=-1)
         return self._call(1, params)
 
     @property
@@ -233,8 +240,7 @@ class Likelihood:
         if not n_sets:
             return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
         matrix = set_matrix([v for _, v in columns], n_sets)
-        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
-                        and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
+        sizes = self._sizes()
         rows = _block_rows(n_sets, sizes)
         out = []
         for i in range(0, n_sets, rows):
@@ -246,6 +252,11 @@ class Likelihood:
                 block = np.concatenate([block, np.repeat(block[-1:], size - n, axis=0)])
             out.append(np.asarray(self._jitted[key](block))[:n])
         return out[0] if len(out) == 1 else np.concatenate(out, axis=0)
+
+    def _sizes(self) -> list[int]:
+        """The numbers of sets one compiled call takes (``_BATCH_SIZES`` this likelihood uses, and ``exact_sizes``)."""
+        return sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
+                       and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
 
     def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
         return jax.jit(self.function(which, names, scalars, levels))

@@ -24,7 +24,7 @@ def synthetic(model_spec, truth, n_theta_i=(20, 40, 60), n_r=8, dop_err=0.01, br
     return data
 
 
-def test_resumed_chain_equals_uninterrupted(tmp_path):
+def test_resumed_chain_equals_uninterrupted(tmp_path, capsys):
     data = synthetic("paper", {"n": 1.4, "k": 0.2, "sigma": 0.2, "ks": 0.5, "rho_d": 0.1})
     post = Posterior.build(data, Model.from_string("paper"))
     kwargs = dict(walkers=16, max_steps=600, check_every=200, min_steps=10**9, progress=False, initial="prior")
@@ -44,8 +44,12 @@ def test_resumed_chain_equals_uninterrupted(tmp_path):
                 raise KeyboardInterrupt  # Ctrl-C in the middle of a step
             return self.inner.log_likelihood(theta, inside)
 
+    capsys.readouterr()
     with pytest.raises(KeyboardInterrupt):
         sample_emcee(Interrupting(post, after=451), np.random.default_rng(7), backend_path=tmp_path / "b.h5", **kwargs)
+    # the interruption reaches the caller (the command line says one line) without emcee's dump of the walkers
+    printed = capsys.readouterr()
+    assert "emcee: Exception" not in printed.out + printed.err and "Traceback" not in printed.out + printed.err
     import emcee
 
     partial = emcee.backends.HDFBackend(str(tmp_path / "b.h5"), name="mcmc", read_only=True)

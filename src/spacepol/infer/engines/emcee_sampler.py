@@ -201,8 +201,11 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         if backend_path is not None:
             extra = {} if start_search is None else {"spacepol_start_search": json.dumps(start_search)}
             _store(backend_path, spacepol_space=space.name, **extra)
-    sampler = emcee.EnsembleSampler(walkers, ndim, space.log_prob(posterior), vectorize=True, moves=_moves(),
-                                    backend=backend)
+    log_prob = space.log_prob(posterior)
+    sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=_moves(), backend=backend)
+    # called directly, not through emcee's wrapper, which prints every walker's position and a traceback before it
+    # re-raises anything the function raises (Ctrl-C included), under the command line's one line
+    sampler.log_prob_fn = log_prob
     tau, previous_tau, capped = np.full(ndim, np.inf), None, True
 
     def converged(tau, previous_tau):

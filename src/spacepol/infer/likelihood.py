@@ -201,8 +201,9 @@ class Likelihood:
     def total(self, params: dict) -> np.ndarray:
         """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept); on a
         large data set (``compiles_one_block``), where a call's block holds at most ``_POINTWISE_NUMBERS`` numbers,
-        the sum of ``pointwise``, so that a model compiles one likelihood program, not two (PTFE, 278 full-Mueller geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to
-        compile, and every model diagnose refits needs the pointwise one too)."""
+        the sum of ``pointwise``, so that a model compiles one likelihood program, not two (PTFE, 278 full-Mueller
+        geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to compile, and every model diagnose refits
+        needs the pointwise one too)."""
         if self.compiles_one_block:
             n_sets = max((np.size(v) for v in params.values() if np.ndim(v)), default=0)
             if _block_rows(n_sets, self._sizes()) * self.numbers_per_set <= _POINTWISE_NUMBERS:

@@ -204,10 +204,6 @@ class Likelihood:
         the sum of ``pointwise``, so that a model compiles one likelihood program, not two (PTFE, 278 full-Mueller
         geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to compile, and every model diagnose refits
         needs the pointwise one too)."""
-        if self.compiles_one_block:
-            n_sets = max((np.size(v) for v in params.values() if np.ndim(v)), default=0)
-            if _block_rows(n_sets, self._sizes()) * self.numbers_per_set <= _POINTWISE_NUMBERS:
-                return self._call(0, params).sum(axis=-1)
         return self._call(1, params)
 
     @property
@@ -235,14 +231,18 @@ class Likelihood:
                 v = np.asarray(v, float).reshape(-1)
                 columns.append((name, v))
                 n_sets = max(n_sets, v.size)
-        key = (which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())), levels)
+        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
+                        and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
+        rows = _block_rows(n_sets, sizes)
+        # ``total`` of a large likelihood: the pointwise program, summed (see ``total``)
+        summed = which == 1 and self.compiles_one_block and rows * self.numbers_per_set <= _POINTWISE_NUMBERS
+        key = (0 if summed else which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())), levels)
         if key not in self._jitted:
             self._jitted[key] = self._compile(*key)
         if not n_sets:
-            return np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
+            out = np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
+            return out.sum(axis=-1) if summed else out
         matrix = set_matrix([v for _, v in columns], n_sets)
-        sizes = self._sizes()
-        rows = _block_rows(n_sets, sizes)
         out = []
         for i in range(0, n_sets, rows):
             block = matrix[i : i + rows]
@@ -252,12 +252,8 @@ class Likelihood:
             if size > n:  # padded with the last set (a valid one)
                 block = np.concatenate([block, np.repeat(block[-1:], size - n, axis=0)])
             out.append(np.asarray(self._jitted[key](block))[:n])
-        return out[0] if len(out) == 1 else np.concatenate(out, axis=0)
-
-    def _sizes(self) -> list[int]:
-        """The numbers of sets one compiled call takes (``_BATCH_SIZES`` this likelihood uses, and ``exact_sizes``)."""
-        return sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
-                       and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
+        out = out[0] if len(out) == 1 else np.concatenate(out, axis=0)
+        return out.sum(axis=-1) if summed else out
 
     def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
         return jax.jit(self.function(which, names, scalars, levels))

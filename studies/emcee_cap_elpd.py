@@ -31,7 +31,8 @@ def main(models):
     from spacepol.criticism.candidate_fits import _build
     from spacepol.infer.engines.emcee_sampler import _moves, _tau, ball, default_walkers, reaching_a_bound
     from spacepol.infer.optimum import multistart
-    from spacepol.infer.psis import logsumexp_rows, psis_log_weights
+    from spacepol.infer.diagnostics import psis_loo
+    from spacepol.infer.inference_data import batched
     from spacepol.infer.sampling_space import SamplingSpace
     from spacepol.physics import Model
 
@@ -39,12 +40,7 @@ def main(models):
     base_loo = base_pointwise(data)
 
     def pointwise_loo(post, theta):
-        ll = np.concatenate([post.log_prob_pointwise(theta[i : i + 256]) for i in range(0, len(theta), 256)]).T
-        log_weights, _ = psis_log_weights(-ll)
-        out = logsumexp_rows(log_weights + ll)
-        failed = ~np.isfinite(out)  # as diagnostics.loo: the in-sample density where PSIS fails
-        out[failed] = logsumexp_rows(ll[failed]) - np.log(ll.shape[1])
-        return out
+        return psis_loo(batched(post.log_prob_pointwise, theta, 256).T)[0]  # relative efficiency 1
 
     for spec in models:
         post = _build(data, Model.from_string(spec), None, None)

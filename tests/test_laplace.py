@@ -130,10 +130,18 @@ def test_weights_collapsed_onto_the_mode_of_a_ridge_are_refused():
     data = _ptfe_ridge_set()
     ridge = Posterior.build(data, Model.from_string("paper+lambertian+oxide_layer"))
     _, centre = multistart(ridge, np.random.default_rng(0))
-    sample = laplace_importance(ridge, centre, np.random.default_rng(2))
-    assert sample is not None and not sample.reliable
-    assert sample.pareto_k <= 0.7 and sample.effective_draws >= 400, (sample.pareto_k, sample.effective_draws)
-    assert sample.width_ratio < 0.6 < MIN_WIDTH_RATIO, sample.width_ratio
+    # every seed's proposal is refused by its width; the first one the old gate alone would have trusted (Pareto k
+    # and effective draws pass; which seed that is moves with the likelihood's last digits) shows that the width is
+    # what refuses it
+    seen = []
+    for seed in range(8):
+        sample = laplace_importance(ridge, centre, np.random.default_rng(seed))
+        assert sample is not None and not sample.reliable and sample.width_ratio < 0.65 < MIN_WIDTH_RATIO, sample.width_ratio
+        seen.append((sample.pareto_k, sample.effective_draws))
+        if sample.pareto_k <= 0.7 and sample.effective_draws >= 400:
+            break
+    else:
+        raise AssertionError(f"no proposal passed the old gate (Pareto k, effective draws): {seen}")
     control = Posterior.build(data, Model.from_string("paper"))
     _, centre = multistart(control, np.random.default_rng(0))
     kept = laplace_importance(control, centre, np.random.default_rng(0))

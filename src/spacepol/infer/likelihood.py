@@ -278,51 +278,69 @@ class Likelihood:
             raise ValueError("noise levels are profiled under the Gaussian likelihood only (robust=False)")
         profiled_names = [name for name, _, _ in levels]
 
+        groups = self._channel_groups()
+
         def residuals(values):
-            """Each channel's residuals, (P, N) or broadcastable, in ``self.observables``' order."""
+            """Each channel group's residuals, (channels, P or 1, N or 1), in ``self.observables``' order."""
             total, dop = program({k: v for k, v in values.items() if k in model_names}, program.inputs)
             prediction = Prediction.from_total(total, dop, mueller)
-            predicted = {}
-            for o in self.objects:
-                predicted.update(o.predict(prediction))
-            return [self._owner[ch].residual(ch, y[ch], predicted[ch], self.inferred(ch)) for ch in self.observables]
+            out, predicted = [], {}
+            for o, channels in groups:
+                if len(channels) > 1:  # one array for the group (``Observable.predict_stacked``)
+                    observed = jnp.stack([y[ch] for ch in channels])[:, None, :]
+                    out.append(o.residual(channels[0], observed, o.predict_stacked(prediction), self.inferred(channels[0])))
+                    continue
+                ch = channels[0]
+                if ch not in predicted:
+                    predicted.update(o.predict(prediction))
+                out.append(o.residual(ch, y[ch], predicted[ch], self.inferred(ch))[None])
+            return out
 
         def profile_levels(resids, n_sets):
             """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
             out = []
             for name, lower, upper in levels:
                 squares, count = 0.0, 0
-                for ch, resid in zip(self.observables, resids):
-                    if ch not in errors and self.noise_parameter(ch) == name:
-                        z = resid / profiles.get(ch, 1.0)
-                        squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
-                        count += len(self.data)
+                for (_, channels), resid in zip(groups, resids):
+                    for c, ch in enumerate(channels):
+                        if ch not in errors and self.noise_parameter(ch) == name:
+                            z = resid[c] / profiles.get(ch, 1.0)
+                            squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
+                            count += len(self.data)
                 out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
             return out
 
         def channel_blocks(matrix):
-            """(the log-likelihood of each channel, (P, N) each, in ``self.observables``' order; the profiled
-            levels' values, (P,) each, in ``levels``' order)."""
+            """(the log-likelihood of each channel group, (channels, P, N) each, in ``self.observables``' order;
+            the profiled levels' values, (P,) each, in ``levels``' order)."""
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
             resids = residuals(values)
             profiled = profile_levels(resids, matrix.shape[0]) if levels else []
             values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
             blocks = []
-            for ch, resid in zip(self.observables, resids):
-                scale = errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0)
-                lp = self._logpdf(ch, resid, scale)
-                blocks.append(jnp.broadcast_to(lp, jnp.broadcast_shapes(jnp.shape(lp), (matrix.shape[0], len(self.data)))))
+            for (_, channels), resid in zip(groups, resids):
+                # each channel's noise as (P or 1, N or 1), stacked over the group's channels
+                scales = [jnp.asarray(errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0))
+                          for ch in channels]
+                scales = [jnp.broadcast_to(sc, jnp.broadcast_shapes(sc.shape, (1, 1))) for sc in scales]
+                scale = jnp.stack(jnp.broadcast_arrays(*scales))
+                lp = self._logpdf(channels[0], resid, scale)
+                blocks.append(jnp.broadcast_to(lp, (len(channels), matrix.shape[0], len(self.data))))
             return blocks, profiled
 
         def pointwise(matrix):
-            return jnp.concatenate(channel_blocks(matrix)[0], axis=-1)
+            # (channels, P, N) -> (P, channels x N): each channel's N values in a row, in ``observables``' order
+            return jnp.concatenate([jnp.moveaxis(b, 0, 1).reshape(matrix.shape[0], -1) for b in channel_blocks(matrix)[0]],
+                                   axis=-1)
 
         def summed(matrix):
-            # the channels added element by element, then one sum over the rows: one reduction (summed from a
+            # the single channels added element by element, then one sum over the rows: one reduction (summed from a
             # concatenation, XLA stored every Mueller element and reduced each channel in a partitioned loop of
             # its own: 32 loops and their hand-overs between threads per call, 16 of them reductions)
             blocks, profiled = channel_blocks(matrix)
-            value = sum(blocks).sum(axis=-1)
+            single = [b[0] for b in blocks if len(b) == 1]
+            value = sum(single).sum(axis=-1) if single else 0.0
+            value = value + sum(b.sum(axis=(0, 2)) for b in blocks if len(b) > 1)
             return jnp.stack([value, *profiled], axis=-1) if levels else value
 
         def total(matrix):
@@ -338,6 +356,17 @@ class Likelihood:
             return out.reshape((n_sets,) + out.shape[2:])
 
         return pointwise if which == 0 else total
+
+    def _channel_groups(self) -> list[tuple]:
+        """[(observable, its channels)]: an observable's channels as one group where it predicts them as one array
+        (``Observable.predict_stacked``) and its noise is of one kind for all of them (all the file's errors, or all
+        inferred); else each channel alone. In ``observables``' order."""
+        out = []
+        for o in self.objects:
+            kinds = {self.inferred(ch) for ch in o.channels}
+            stacked = len(o.channels) > 1 and len(kinds) == 1 and type(o).predict_stacked is not obs.Observable.predict_stacked
+            out.extend([(o, tuple(o.channels))] if stacked else [(o, (ch,)) for ch in o.channels])
+        return out
 
     def _logpdf(self, channel, resid, scale):
         if not self.robust:

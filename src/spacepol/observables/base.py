@@ -105,6 +105,13 @@ class Observable:
         """{channel: (..., N) model values} from a ``physics.model.Prediction``."""
         raise NotImplementedError
 
+    def predict_stacked(self, prediction):
+        """All channels' predictions as one array (channels, ..., N) in ``channels``' order, or None (the default:
+        the likelihood then takes the channels one by one). An observable that gives one promises that its
+        ``residual`` and ``log_density`` do not depend on the channel, so the likelihood forms them on the whole
+        array: one compiled loop instead of one per channel (XLA compiles each loop separately)."""
+        return None
+
     def noise_space(self, channel: str, mu, inferred: bool):
         """A prediction in the space where the noise is Gaussian (the value itself; log BRDF for a relative noise)."""
         return mu

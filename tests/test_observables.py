@@ -218,3 +218,66 @@ def test_mueller_residuals_are_drawn_as_the_matrix():
     assert all(ax.title.get_color() == "k" for ax in good.axes if ax.get_title())
     bad = mueller_residual_figure(post, Draws({**TRUTH, "n": 1.9}))
     assert any(ax.title.get_color() == "C3" for ax in bad.axes if ax.get_title())
+
+
+def test_mueller_channels_fitted_as_one_block_equal_the_direct_computation():
+    """The 15 Mueller channels go through the compiled likelihood as one array (``Observable.predict_stacked``):
+    for three parameter sets, with inferred noise (three group levels) and with the file's per-element errors, the
+    pointwise values equal the direct computation, ``total`` their sum and ``profiled`` the levels' closed-form
+    maxima (the RMS of each group's residuals). Negative control: the groups' levels swapped give other values."""
+    data, g = _data(np.random.default_rng(5))
+    model = Model.from_string(MODEL)
+    sets = [OTHER, {**OTHER, "n": 1.45, "sigma": 0.3}, {**OTHER, "k": 0.2, "rho_pd": 0.3}]
+    params = {k: np.array([s[k] for s in sets]) for k in TRUTH}
+    noise = {"sigma_m_pol": 0.011, "sigma_m_lin": 0.013, "sigma_m_circ": 0.02}
+    lik = Likelihood(data, model, observables=["mueller"])
+    got = lik.pointwise({**params, **{k: np.full(3, v) for k, v in noise.items()}})
+    want = np.array([_direct("mueller", data, g, {**s, **noise}) for s in sets])
+    np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(lik.total({**params, **{k: np.full(3, v) for k, v in noise.items()}}), want.sum(axis=1),
+                               rtol=1e-12)
+    swapped = {"sigma_m_pol": 0.02, "sigma_m_lin": 0.013, "sigma_m_circ": 0.011}
+    assert not np.allclose(lik.pointwise({**params, **{k: np.full(3, v) for k, v in swapped.items()}}), want)
+    # the levels profiled: each the RMS of its group's residuals (clipped to its bounds)
+    levels = tuple((k, 1e-4, 0.5) for k in noise)
+    value, found = lik.profiled(params, levels)
+    for j, s in enumerate(sets):
+        p = model.evaluate(s, g, mueller=True)
+        resid = data.mueller / data.mueller[0, 0] - p.mueller / p.mueller[0, 0]
+        groups = {"sigma_m_pol": [(0, 1), (0, 2), (0, 3), (1, 0), (2, 0), (3, 0)],
+                  "sigma_m_lin": [(1, 1), (1, 2), (2, 1), (2, 2)]}
+        groups["sigma_m_circ"] = [(i, k) for i in range(4) for k in range(4) if (i, k) != (0, 0)
+                                  and not any((i, k) in m for m in groups.values())]
+        rms = {name: np.sqrt(np.mean([resid[e] ** 2 for e in members])) for name, members in groups.items()}
+        for name in noise:
+            assert found[name][j] == pytest.approx(rms[name], rel=1e-10)
+        assert value[j] == pytest.approx(_direct("mueller", data, g, {**s, **rms}).sum(), rel=1e-10)
+    # the file's errors, one per element and row
+    data.mueller_err = np.linspace(0.005, 0.03, 16).reshape(4, 4, 1) * np.linspace(1.0, 2.0, g.size)
+    lik = Likelihood(data, model, observables=["mueller"])
+    assert lik.nuisance == []
+    want = []
+    for s in sets:
+        p = model.evaluate(s, g, mueller=True)
+        want.append(np.concatenate([_gauss(data.mueller[i, k] / data.mueller[0, 0] - p.mueller[i, k] / p.mueller[0, 0],
+                                           data.mueller_err[i, k]) for i in range(4) for k in range(4) if i or k]))
+    np.testing.assert_allclose(lik.pointwise(params), np.array(want), rtol=1e-10, atol=1e-10)
+
+
+def test_which_observables_read_the_measured_dop_and_which_effects_change_it_alone():
+    """diagnose leaves out changes the fitted observables cannot see (``changes.blind_changes``): found by probing each
+    observable's prediction (only the DOP reads the measured DOP; q, u, DoLP and DoCP are computed from the Stokes
+    vector) and each effect's hooks (only dop_bias acts on the measured DOP alone)."""
+    from spacepol.criticism.changes import blind_changes, changes, measured_dop_only, reads_measured_dop
+    from spacepol.observables import registry as observables
+    from spacepol.physics.registry import registry as effects
+
+    readers = {name for name in observables.names() if reads_measured_dop(observables.get(name))}
+    assert readers == {"dop"}, readers
+    assert {name for name in effects.names() if measured_dop_only(effects.get(name))} == {"dop_bias"}
+    data, _ = _data(np.random.default_rng(0))
+    model = Model.from_string("specular+smith")
+    candidates = changes(model, data, ["dop_bias", "lambertian"])
+    mueller = Likelihood(data, model, observables=["mueller", "brdf"]).objects
+    assert [c.label for c in blind_changes(candidates, mueller)] == ["add dop_bias"]
+    assert blind_changes(candidates, Likelihood(data, model, observables=["dop", "brdf"]).objects) == []

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SpacepolError
-from ..physics.model import Model
+from ..physics.effect import Effect
+from ..physics.model import Model, Prediction
 from ..physics.registry import registry
 from ..physics.spectral import SpectralModel
 
@@ -106,6 +107,52 @@ def changes(model: Model, data, names=None) -> list[Change]:
             except SpacepolError:
                 continue  # another effect needs it
     return out
+
+
+# the hooks through which an effect changes the Stokes vector or Mueller matrix (``physics.effect``); ``modify_dop``
+# changes only the measured DOP read from them
+_LIGHT_HOOKS = ("transform_geometry", "configure", "specular_factor", "modify_specular", "lobe", "modify_stokes")
+
+
+def measured_dop_only(effect_class) -> bool:
+    """Whether an effect changes the measured DOP alone (its only hook is ``modify_dop``, as a DOP estimator's bias):
+    it cannot change any observable computed from the Stokes vector or Mueller matrix."""
+    return (effect_class.modify_dop is not Effect.modify_dop
+            and all(getattr(effect_class, hook) is getattr(Effect, hook) for hook in _LIGHT_HOOKS))
+
+
+class _Probe(Prediction):
+    """A prediction that records whether the measured DOP was read."""
+
+    def __getattribute__(self, name):
+        if name == "dop":
+            object.__setattr__(self, "dop_read", True)
+        return super().__getattribute__(name)
+
+
+def reads_measured_dop(observable) -> bool:
+    """Whether ``observable``'s prediction reads the model's measured DOP (``Prediction.dop``), found by running its
+    ``predict`` on a probe that records what it reads (so a plug-in observable needs to declare nothing); one that
+    fails on the probe counts as reading it."""
+    stokes = np.array([[1.0], [0.3], [0.2], [0.1]])
+    mueller = np.tile(np.eye(4)[:, :, None] * 0.5, (1, 1, 1))
+    mueller[:, 0] = stokes
+    probe = _Probe(stokes=stokes, dop=np.array([0.37]), mueller=mueller)
+    try:
+        observable.predict(probe)
+    except Exception:
+        return True
+    return bool(getattr(probe, "dop_read", False))
+
+
+def blind_changes(candidates: list[Change], fitted) -> list[Change]:
+    """The additions and replacements among ``candidates`` that cannot change the likelihood of the ``fitted``
+    observables: the new effect changes the measured DOP alone (``measured_dop_only``) and no fitted observable
+    reads it (the normalised Mueller matrix, BRDF or Stokes data). Their fit would differ from the model's by their
+    prior alone."""
+    if any(reads_measured_dop(o) for o in fitted):
+        return []
+    return [c for c in candidates if c.kind != "remove" and measured_dop_only(registry.get(c.effect))]
 
 
 def slot_alternatives(model: Model, data, slots, names=None) -> list[str]:

@@ -14,7 +14,8 @@
    (``_dominated``) could neither lead nor tie, and is not refitted.
 4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
    explanation says what measurement separates them (as the effects declare it). Effects declared
-   twins are always refitted together.
+   twins are always refitted together, except on data whose fitted observables separate them
+   (``Effect.separated_by``).
 5. A significant change whose residuals stay structured "helps, but does not explain the misfit".
 """
 
@@ -37,7 +38,7 @@ from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
 from .candidate_fits import CandidateFits, fit_for_elpd, model_key
-from .changes import changes, separating_measurement
+from .changes import blind_changes, changes, separating_measurement
 from .records import CandidateFit, DiagnosisRecord
 
 
@@ -102,6 +103,9 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         searched[model_key(model)] = _global_optimum(base_post, rng, screening_evaluations)
     base_best, base_optimum = searched[model_key(model)]
     all_candidates = changes(model, data, candidates)
+    # changes the fitted observables cannot see (a DOP estimator's bias on Mueller data) are not screened
+    blind = blind_changes(all_candidates, base_post.likelihood.objects)
+    all_candidates = [c for c in all_candidates if c not in blind]
     if base is None:
         if progress:
             _say(f"[base] fitting {model.name} ({len(data)} geometries) ...")
@@ -112,6 +116,9 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
 
     if progress:
         _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
+        if blind:
+            _say(f"[screen] not screened: {', '.join(c.label for c in blind)} (changes only the measured DOP, which "
+                 "these data's fitted observables do not read)")
     posteriors = [fits.posterior(change.model) for change in all_candidates]
     unsearched = [i for i, change in enumerate(all_candidates) if model_key(change.model) not in searched]
 
@@ -140,8 +147,12 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     clock["screening"] = time.perf_counter()
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
     to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c.screening_gain, screened[0].screening_gain)]
-    # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits
-    twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins}
+    # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits; not
+    # where the fitted observables separate the two (``Effect.separated_by``: the full Mueller matrix for an analyser
+    # and depolarized light), where the twin is refitted only if its own screening earns it
+    fitted = set(base_post.likelihood.observable_names)
+    twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins
+             if not fitted & set(_separating_observables(c.effect, t))}
     to_confirm += [c for c in screened if c not in to_confirm and c.kind == "add" and c.effect in twins]
     to_confirm += [c for c in screened if c not in to_confirm and c.label in confirm]
     # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
@@ -283,6 +294,8 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["free_parameters"] = c.posterior.ndim
     return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
             "ranking": ranking, "verdict": verdict,
+            "not_screened": [{"change": c.label, "reason": "it changes only the measured DOP, which none of the fitted "
+                              "observables reads: its fit would differ from the model's by its prior alone"} for c in blind],
             "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
@@ -292,6 +305,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)}},
                            base, confirmed)
+
+
+def _separating_observables(a: str, b: str) -> tuple:
+    """The observables whose fit separates twins ``a`` and ``b``, as either declares them (``Effect.separated_by``)."""
+    return tuple(registry.get(a).separated_by.get(b, ())) + tuple(registry.get(b).separated_by.get(a, ()))
 
 
 def _same_posterior(result, posterior) -> bool:

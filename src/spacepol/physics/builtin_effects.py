@@ -231,6 +231,7 @@ class Depolarization(Effect):
         "DOP of the specular lobe at every angle by the same factor."
     )
     twins = {"extinction": "the full Mueller matrix (an analyser acts on the detector side only, depolarization on the light itself: M12 and M21 differ)"}
+    separated_by = {"extinction": ("mueller",)}
     neutral = {"d_spec": 0.0}
 
     def modify_specular(self, ctx, lobe):
@@ -342,6 +343,7 @@ class Extinction(Effect):
     )
     reciprocal = False
     twins = {"depolarization": "the full Mueller matrix (an analyser acts on the detector side only, depolarization on the light itself: M12 and M21 differ)"}
+    separated_by = {"depolarization": ("mueller",)}
     neutral = {"e": 1.0}
 
     def modify_stokes(self, ctx, total):

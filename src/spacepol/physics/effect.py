@@ -146,6 +146,9 @@ class Effect:
       addition, though it has no slot;
     * ``twins``: {other effect: the measurement that separates them} for effects that predict the
       same thing on some data (both are then always refitted, and a tie is reported with it);
+    * ``separated_by``: {twin: observable names}, where fitting any of these observables tells the two apart
+      (the full Mueller matrix separates an analyser from depolarized light): on such data the twin is
+      refitted only if its own screening earns it;
     * ``neutral``: parameter values at which the effect changes nothing (where the optimiser starts
       it when it is added to a fitted model);
     * ``splits``: {own parameter: model parameter it refines} (anisotropy's sigma_x starts at sigma);
@@ -168,6 +171,7 @@ class Effect:
     removable: bool = False
     essential: bool = False
     twins: dict = {}
+    separated_by: dict = {}
     neutral: dict = {}
     splits: dict = {}
     branches: tuple = ()
@@ -230,7 +234,7 @@ _STAGES = {"lobe", "specular_factor", "modify_specular", "modify_stokes", "modif
 
 
 def effect(name: str, *, stage: str, parameters=(), requires=(), description: str = "", reciprocal: bool = True,
-           slot: str | None = None, removable: bool = False, twins=None, neutral=None):
+           slot: str | None = None, removable: bool = False, twins=None, neutral=None, separated_by=None):
     """Decorator that turns a function into an effect class.
 
     ``stage`` names the hook the function implements; it is called as ``fn(ctx, ...)`` with
@@ -260,6 +264,7 @@ def effect(name: str, *, stage: str, parameters=(), requires=(), description: st
             "slot": slot,
             "removable": removable,
             "twins": dict(twins or {}),
+            "separated_by": {twin: tuple(names) for twin, names in (separated_by or {}).items()},
             "neutral": dict(neutral or {}),
             stage: hook,
             "__module__": fn.__module__,

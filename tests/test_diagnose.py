@@ -208,8 +208,9 @@ def test_a_refit_whose_chain_did_not_converge_is_said_so():
 
 def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
     """diagnose --workers: candidates screened, searched and refitted in two worker processes give the ranking the
-    same seed gives in one process, number for number (each task draws its own seed in candidate order); control:
-    another seed does change the screening gains, so the comparison can see a difference."""
+    same seed gives in one process, number for number (each task's seed is its kind's and model's own); control:
+    another seed does change the screening gains, so the comparison can see a difference. Nor does a candidate's fit
+    depend on the other candidates: with dop_bias left out, polarized_diffuse's changes get the same numbers."""
     from spacepol.criticism.hidden_effects import suite
 
     case = next(c for c in suite() if c.effect == "polarized_diffuse")
@@ -236,6 +237,15 @@ def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
             assert elpd_one == pytest.approx(elpd_two, rel=1e-9, abs=1e-9), change
     other, _ = ranking(1, seed=case.seed + 1)
     assert any(abs(other[c][0] - one[c][0]) > 1e-6 for c in one), (one, other)
+    # nor on which other candidates are fitted: each task's seed is its model's own (``candidate_fits.task_seed``)
+    candidates = ["polarized_diffuse"]
+    alone, _ = ranking(1)
+    assert alone.keys() < one.keys()
+    for change in alone:
+        assert alone[change][0] == pytest.approx(one[change][0], rel=1e-9, abs=1e-9), change
+        assert (alone[change][1] is None) == (one[change][1] is None), change
+        if alone[change][1] is not None:
+            assert alone[change][1] == pytest.approx(one[change][1], rel=1e-9, abs=1e-9), change
 
 
 _POOL_SCRIPT = """

@@ -2,9 +2,10 @@
 worker processes at once (``CandidateFits``), with the same answer either way.
 
 Processes, not threads: a candidate's work holds Python's global lock (two threads screening two candidates took as
-long as one after the other on PTFE), so only separate processes use a second core. Each task gets its own seed,
-drawn from the caller's generator in task order before any task starts, so the results do not depend on the number
-of workers or on the order tasks finish in. A worker receives the data once, builds each posterior itself (a
+long as one after the other on PTFE), so only separate processes use a second core. Each task's seed comes from one
+draw of the caller's generator (at the first task) and the task's kind and model alone (``task_seed``), so the results
+do not depend on the number of workers, on the order tasks finish in, or on which other candidates were fitted
+before (a candidate left out or added changes no other candidate's fit). A worker receives the data once, builds each posterior itself (a
 compiled likelihood cannot be sent between processes) and sends back numbers and Results without their posterior,
 which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this process (a
 fresh worker would not know the file).
@@ -15,6 +16,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import time
+import zlib
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Iterator
 
@@ -42,6 +44,13 @@ def model_key(model) -> tuple:
     """What identifies a model among diagnose's candidates (its ``searched`` maxima, the posteriors kept): its
     effects in order and its wavelengths."""
     return model.name, tuple(getattr(model, "wavelengths", ()))
+
+
+def task_seed(root: int, kind: str, key: tuple) -> int:
+    """The seed of one task (``screen``, ``leader``, ``refit``) of the model ``key`` (``model_key``) under a root seed:
+    independent streams for different tasks and models (numpy's SeedSequence), the same for the same ones."""
+    entropy = [root, zlib.crc32(f"{kind}|{key!r}".encode())]
+    return int(np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0] >> np.uint64(1))
 
 
 def _build(data, model, observables, priors, check: bool = True):
@@ -137,7 +146,7 @@ class CandidateFits:
     def __init__(self, data, observables=None, priors: dict | None = None, workers: int = 1):
         self.data, self.observables, self.priors = data, observables, priors
         self.workers = max(1, int(workers))
-        self._pool = None
+        self._pool, self._root = None, None
 
     def posterior(self, model) -> Posterior:
         """The candidate's posterior in this process, not checked (``Posterior.ensure_checked``) until a task runs
@@ -148,9 +157,11 @@ class CandidateFits:
         return _build(self.data, model, self.observables, self.priors, check=False)
 
     def run(self, kind: str, jobs: list[tuple], rng: np.random.Generator) -> Iterator[tuple[int, object]]:
-        """(index, result) per job, as jobs finish; a job is (model, posterior in this process, args...) and gets a
-        seed from ``rng`` (drawn per job in order before any starts) as its ``seed`` argument."""
-        seeds = [int(s) for s in rng.integers(2**63, size=len(jobs))]
+        """(index, result) per job, as jobs finish; a job is (model, posterior in this process, args...) and gets as
+        its ``seed`` argument ``task_seed`` of its kind and model (the root drawn from ``rng`` at the first call)."""
+        if self._root is None:
+            self._root = int(rng.integers(2**63))
+        seeds = [task_seed(self._root, kind, model_key(job[0])) for job in jobs]
         parallel = self.workers > 1 and len(jobs) > 1 and not any(_from_a_file(job[0]) for job in jobs)
         if not parallel:
             for i, (job, seed) in enumerate(zip(jobs, seeds)):

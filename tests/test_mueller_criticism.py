@@ -28,6 +28,9 @@ def test_the_full_mueller_matrix_separates_the_twins(kind):
     # a DOP estimator's bias cannot change the Mueller and BRDF likelihood: not screened, and said so
     assert [e["change"] for e in report["not_screened"]] == ["add dop_bias"]
     assert not any(r["effect"] == "dop_bias" for r in report["ranking"])
+    from spacepol.report.diagnose_report import significance_statement
+
+    assert "not screened, since they change only the measured DOP" in significance_statement(report)
     lead = report["ranking"][0]
     assert report["verdict"] == kind and not lead.get("tied_with"), (report["verdict"], lead.get("tied_with"))
     other = next(r for r in report["ranking"] if r["effect"] == {"depolarization": "extinction",

@@ -5,9 +5,9 @@ Processes, not threads: a candidate's work holds Python's global lock (two threa
 long as one after the other on PTFE), so only separate processes use a second core. Each task's seed comes from one
 draw of the caller's generator (at the first task) and the task's kind and model alone (``task_seed``), so the results
 do not depend on the number of workers, on the order tasks finish in, or on which other candidates were fitted
-before (a candidate left out or added changes no other candidate's fit). A worker receives the data once, builds each posterior itself (a
-compiled likelihood cannot be sent between processes) and sends back numbers and Results without their posterior,
-which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this process (a
+before (a candidate left out or added changes no other candidate's fit). A worker receives the data once, builds each
+posterior itself (a compiled likelihood cannot be sent between processes) and sends back numbers and Results without
+their posterior, which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this process (a
 fresh worker would not know the file).
 """
 

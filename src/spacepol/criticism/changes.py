@@ -117,8 +117,9 @@ _LIGHT_HOOKS = ("transform_geometry", "configure", "specular_factor", "modify_sp
 def measured_dop_only(effect_class) -> bool:
     """Whether an effect changes the measured DOP alone (its only hook is ``modify_dop``, as a DOP estimator's bias):
     it cannot change any observable computed from the Stokes vector or Mueller matrix."""
-    return (effect_class.modify_dop is not Effect.modify_dop
-            and all(getattr(effect_class, hook) is getattr(Effect, hook) for hook in _LIGHT_HOOKS))
+    cls = effect_class if isinstance(effect_class, type) else type(effect_class)  # a plug-in may be an instance
+    return (cls.modify_dop is not Effect.modify_dop
+            and all(getattr(cls, hook) is getattr(Effect, hook) for hook in _LIGHT_HOOKS))
 
 
 class _Probe(Prediction):
@@ -135,7 +136,7 @@ def reads_measured_dop(observable) -> bool:
     ``predict`` on a probe that records what it reads (so a plug-in observable needs to declare nothing); one that
     fails on the probe counts as reading it."""
     stokes = np.array([[1.0], [0.3], [0.2], [0.1]])
-    mueller = np.tile(np.eye(4)[:, :, None] * 0.5, (1, 1, 1))
+    mueller = np.eye(4)[:, :, None] * 0.5
     mueller[:, 0] = stokes
     probe = _Probe(stokes=stokes, dop=np.array([0.37]), mueller=mueller)
     try:

@@ -106,10 +106,11 @@ class Observable:
         raise NotImplementedError
 
     def predict_stacked(self, prediction):
-        """All channels' predictions as one array (channels, ..., N) in ``channels``' order, or None (the default:
-        the likelihood then takes the channels one by one). An observable that gives one promises that its
-        ``residual`` and ``log_density`` do not depend on the channel, so the likelihood forms them on the whole
-        array: one compiled loop instead of one per channel (XLA compiles each loop separately)."""
+        """All channels' predictions as one array (channels, ..., N) in ``channels``' order. The base class gives
+        None, and the likelihood then takes the channels one by one; an observable that overrides it always returns
+        the array, and promises that its ``residual`` and ``log_density`` do not depend on the channel, so the
+        likelihood forms them on the whole array: one compiled loop instead of one per channel (XLA compiles each
+        loop separately)."""
         return None
 
     def noise_space(self, channel: str, mu, inferred: bool):

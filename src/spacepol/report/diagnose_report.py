@@ -62,6 +62,10 @@ def significance_statement(report: dict) -> str:
         text += "; not refitted, clearly worse than a refitted change at their own optimum: " + ", ".join(worse)
     if screened:
         text += "; screened out before refitting (their best fit gains too little): " + ", ".join(screened)
+    blind = [e["change"] for e in report.get("not_screened", [])]
+    if blind:
+        text += ("; not screened, since they change only the measured DOP, which none of the fitted observables reads: "
+                 + ", ".join(blind))
     return text + "."
 
 

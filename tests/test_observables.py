@@ -241,13 +241,13 @@ def test_mueller_channels_fitted_as_one_block_equal_the_direct_computation():
     # the levels profiled: each the RMS of its group's residuals (clipped to its bounds)
     levels = tuple((k, 1e-4, 0.5) for k in noise)
     value, found = lik.profiled(params, levels)
+    groups = {"sigma_m_pol": [(0, 1), (0, 2), (0, 3), (1, 0), (2, 0), (3, 0)],
+              "sigma_m_lin": [(1, 1), (1, 2), (2, 1), (2, 2)]}
+    groups["sigma_m_circ"] = [(i, k) for i in range(4) for k in range(4) if (i, k) != (0, 0)
+                              and not any((i, k) in m for m in groups.values())]
     for j, s in enumerate(sets):
         p = model.evaluate(s, g, mueller=True)
         resid = data.mueller / data.mueller[0, 0] - p.mueller / p.mueller[0, 0]
-        groups = {"sigma_m_pol": [(0, 1), (0, 2), (0, 3), (1, 0), (2, 0), (3, 0)],
-                  "sigma_m_lin": [(1, 1), (1, 2), (2, 1), (2, 2)]}
-        groups["sigma_m_circ"] = [(i, k) for i in range(4) for k in range(4) if (i, k) != (0, 0)
-                                  and not any((i, k) in m for m in groups.values())]
         rms = {name: np.sqrt(np.mean([resid[e] ** 2 for e in members])) for name, members in groups.items()}
         for name in noise:
             assert found[name][j] == pytest.approx(rms[name], rel=1e-10)

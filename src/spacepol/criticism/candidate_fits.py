@@ -7,8 +7,8 @@ draw of the caller's generator (at the first task) and the task's kind and model
 do not depend on the number of workers, on the order tasks finish in, or on which other candidates were fitted
 before (a candidate left out or added changes no other candidate's fit). A worker receives the data once, builds each
 posterior itself (a compiled likelihood cannot be sent between processes) and sends back numbers and Results without
-their posterior, which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this process (a
-fresh worker would not know the file).
+their posterior, which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this
+process (a fresh worker would not know the file).
 """
 
 from __future__ import annotations

@@ -146,6 +146,11 @@ def reads_measured_dop(observable) -> bool:
     return bool(getattr(probe, "dop_read", False))
 
 
+# why ``blind_changes`` are not screened, as diagnose's progress and JSON say it
+BLIND_REASON = ("it changes only the measured DOP, which none of the fitted observables reads: its fit would differ "
+                "from the model's by its prior alone")
+
+
 def blind_changes(candidates: list[Change], fitted) -> list[Change]:
     """The additions and replacements among ``candidates`` that cannot change the likelihood of the ``fitted``
     observables: the new effect changes the measured DOP alone (``measured_dop_only``) and no fitted observable
@@ -217,3 +222,9 @@ def separating_measurement(a: str, b: str) -> str | None:
     """What separates two effects declared twins (by either of them), or None if neither declares it."""
     ea, eb = registry.get(a), registry.get(b)
     return ea.twins.get(b) or eb.twins.get(a)
+
+
+def separating_observables(a: str, b: str) -> tuple:
+    """The observables whose fit separates twins ``a`` and ``b``, as either declares them (``Effect.separated_by``)."""
+    ea, eb = registry.get(a), registry.get(b)
+    return tuple(ea.separated_by.get(b, ())) + tuple(eb.separated_by.get(a, ()))

@@ -38,7 +38,7 @@ from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
 from .candidate_fits import CandidateFits, fit_for_elpd, model_key
-from .changes import blind_changes, changes, separating_measurement
+from .changes import BLIND_REASON, blind_changes, changes, separating_measurement, separating_observables
 from .records import CandidateFit, DiagnosisRecord
 
 
@@ -117,8 +117,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     if progress:
         _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
         if blind:
-            _say(f"[screen] not screened: {', '.join(c.label for c in blind)} (changes only the measured DOP, which "
-                 "these data's fitted observables do not read)")
+            _say(f"[screen] not screened: {', '.join(c.label for c in blind)} ({BLIND_REASON})")
     posteriors = [fits.posterior(change.model) for change in all_candidates]
     unsearched = [i for i, change in enumerate(all_candidates) if model_key(change.model) not in searched]
 
@@ -152,7 +151,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     # and depolarized light), where the twin is refitted only if its own screening earns it
     fitted = set(base_post.likelihood.observable_names)
     twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins
-             if not fitted & set(_separating_observables(c.effect, t))}
+             if not fitted & set(separating_observables(c.effect, t))}
     to_confirm += [c for c in screened if c not in to_confirm and c.kind == "add" and c.effect in twins]
     to_confirm += [c for c in screened if c not in to_confirm and c.label in confirm]
     # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
@@ -294,8 +293,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         entry["free_parameters"] = c.posterior.ndim
     return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
             "ranking": ranking, "verdict": verdict,
-            "not_screened": [{"change": c.label, "reason": "it changes only the measured DOP, which none of the fitted "
-                              "observables reads: its fit would differ from the model's by its prior alone"} for c in blind],
+            "not_screened": [{"change": c.label, "reason": BLIND_REASON} for c in blind],
             "free_parameters": base_post.ndim,
             "residual_structure": base.summary["residual_structure"]["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
@@ -305,11 +303,6 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                         "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
                         "candidates_refitted": len(confirmed)}},
                            base, confirmed)
-
-
-def _separating_observables(a: str, b: str) -> tuple:
-    """The observables whose fit separates twins ``a`` and ``b``, as either declares them (``Effect.separated_by``)."""
-    return tuple(registry.get(a).separated_by.get(b, ())) + tuple(registry.get(b).separated_by.get(a, ()))
 
 
 def _same_posterior(result, posterior) -> bool:

@@ -3,9 +3,11 @@ its base's), so that ``help()`` answers for everything a user or a plug-in autho
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import inspect
 import pkgutil
+import sys
 import types
 
 import spacepol
@@ -21,7 +23,8 @@ def undocumented(modules) -> list[str]:
             if inspect.isfunction(obj) and not (obj.__doc__ or "").strip():
                 missing.append(f"{module.__name__}.{name}")
             elif inspect.isclass(obj):
-                if not (obj.__dict__.get("__doc__") or "").strip():
+                own = (obj.__dict__.get("__doc__") or "").strip()
+                if not own or own.startswith(f"{name}("):  # a dataclass's generated signature is not a docstring
                     missing.append(f"{module.__name__}.{name}")
                 for attr, member in vars(obj).items():
                     if attr.startswith("_"):
@@ -48,8 +51,8 @@ def test_every_public_class_and_function_has_a_docstring():
 
 
 def test_the_check_finds_what_is_missing():
-    """Negative control: an undocumented function, class, method and property are all reported; documented ones
-    and private names are not."""
+    """Negative control: an undocumented function, class, method, property and dataclass (its generated signature is
+    no docstring) are all reported; documented ones and private names are not."""
     module = types.ModuleType("spacepol_fake")
     code = '''
 def bare(): pass
@@ -64,7 +67,19 @@ class Told:
     """Documented."""
     def method(self):
         """Documented."""
+@dataclasses.dataclass
+class Record:
+    value: float
+@dataclasses.dataclass
+class Described:
+    """Documented."""
+    value: float
 '''
-    exec(compile(code, "spacepol_fake", "exec"), module.__dict__)
+    module.__dict__["dataclasses"] = dataclasses
+    sys.modules[module.__name__] = module  # a dataclass looks its module up there
+    try:
+        exec(compile(code, "spacepol_fake", "exec"), module.__dict__)
+    finally:
+        del sys.modules[module.__name__]
     assert sorted(undocumented([module])) == ["spacepol_fake.Bare", "spacepol_fake.Bare.method", "spacepol_fake.Bare.value",
-                                              "spacepol_fake.bare"]
+                                              "spacepol_fake.Record", "spacepol_fake.bare"]

@@ -131,7 +131,10 @@ def test_a_users_observable_in_one_file_is_read_fitted_and_reported_from_the_com
     assert refused.returncode == 2 and "unknown column 'pbrdf'" in refused.stderr
     assert len(refused.stderr.strip().splitlines()) == 1 and not out.exists()
 
-    run = cli("run", data, "--model", MODEL, "--observables", f"brdf,{PLUGIN}", "--engine", "laplace", "--seed", "3",
+    # emcee, capped: the facets' ridge here holds it near 0.1 acceptance (20,000 steps do not converge), and the Laplace
+    # approximation sits at its gate (Pareto k 0.71 with one set of packages, trusted with another); this test is
+    # about the plug-in observable, which 4,000 steps place
+    run = cli("run", data, "--model", MODEL, "--observables", f"brdf,{PLUGIN}", "--seed", "3", "--steps", "4000",
               "--quiet", "--out", out)
     assert run.returncode == 0, run.stderr
     summary = json.loads((out / "summary.json").read_text())

@@ -149,6 +149,9 @@ def test_two_runs_on_one_folder_give_one_clear_error(data, tmp_path):
     proc = start("run", data, *slow, "--steps", "20000", "--out", out)
     try:
         wait_for(proc, "step    500/")
+        # paused, not ended: it holds the folder while the second run tries it, and its chain stays unfinished (on a
+        # fast machine it had converged and been written before the second run got going)
+        proc.send_signal(signal.SIGSTOP)
         second = cli("run", data, *slow, "--steps", "20000", "--out", out)
         assert proc.poll() is None, "the first run ended too soon for this test"
         assert second.returncode == 2

@@ -23,7 +23,7 @@ from typing import Iterator
 import numpy as np
 
 from ..infer import elpd_settled
-from ..infer.inversion import invert, invert_laplace
+from ..infer.inversion import invert, laplace_fit
 from ..infer.optimum import multistart, screen_optimum
 from ..infer.posterior import Posterior
 from ..physics.registry import registry
@@ -65,19 +65,23 @@ def _build(data, model, observables, priors, check: bool = True):
 
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
     """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
-    Laplace approximation corrected by importance sampling (``inversion.invert_laplace``), where its Pareto k
-    trusts it, else emcee (stopped before convergence where the ELPD-LOO of its two halves agree, ``elpd_settled``);
-    "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``, ``paper+lambertian``)
-    the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
+    Laplace approximation corrected by importance sampling (``inversion.laplace_fit``), where its checks trust
+    it, else emcee (why not: ``summary["laplace_refused"]``; stopped before convergence where the ELPD-LOO of its
+    two halves agree, ``elpd_settled``); "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``,
+    ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
     (``benchmarks/laplace_vs_emcee.py``)."""
     if posterior_method not in POSTERIOR_METHODS:
         raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
+    refusal = None
     if posterior_method == "laplace":
-        inv = invert_laplace(posterior, centre, seed=seed, draws=ELPD_DRAWS)
+        inv, refusal = laplace_fit(posterior, centre, seed=seed, draws=ELPD_DRAWS)
         if inv is not None:
             return inv
-    return invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
-                  tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS, elpd_tolerance=elpd_settled.TOLERANCE)
+    inv = invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
+                 tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS, elpd_tolerance=elpd_settled.TOLERANCE)
+    if refusal:  # why emcee: the Laplace approximation's failed checks
+        inv.summary["laplace_refused"] = refusal
+    return inv
 
 
 def _screen(post, change, base_optimum: dict, evaluations: int, seed: int) -> tuple[float, dict]:

@@ -19,6 +19,8 @@ from ..physics.spectral import SpectralModel
 
 @dataclass
 class Change:
+    """One change of a model that diagnose screens: an effect added, a slot member replaced, or an effect removed,
+    with the model after it."""
     kind: str  # "add" | "replace" | "remove"
     effect: str  # the effect added, the slot's new member, or the effect removed
     model: Model  # the model after the change

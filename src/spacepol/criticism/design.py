@@ -36,6 +36,7 @@ def default_noise() -> dict[str, float]:
 
 @dataclass
 class Candidate:
+    """A measurement that could be made next: an observable at one geometry (degrees) with its noise."""
     observable: str
     theta_i: float
     theta_r: float

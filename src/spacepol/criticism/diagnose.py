@@ -195,7 +195,9 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             refitted.append(c)
             if progress:
                 q = posterior_quality(inv)
-                how = ("Laplace-IS" if q["engine"] == "laplace-is" else "emcee (the Laplace approximation was not trusted)"
+                refused = f": {q['laplace_refused']}" if q.get("laplace_refused") else ""
+                how = ("Laplace-IS" if q["engine"] == "laplace-is"
+                       else f"emcee (the Laplace approximation was not trusted{refused})"
                        + ("" if q["converged"] else f", which {_unconverged(q)}"))
                 _say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {c.label}: {how}, "
                      f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
@@ -319,12 +321,16 @@ def _same_posterior(result, posterior) -> bool:
 def posterior_quality(inv) -> dict:
     """How a refit's posterior was obtained and whether it can be trusted (``Result.diagnostics``): the engine
     (laplace-is: trusted weights by construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for,
-    else not converged within its cap, or ``stopped_early`` where its ELPD-LOO had settled: ``elpd_settled``)."""
+    else not converged within its cap, or ``stopped_early`` where its ELPD-LOO had settled: ``elpd_settled``; and
+    ``laplace_refused``: why the Laplace approximation was not used, where it was tried)."""
     d = inv.diagnostics
     if d.engine == "laplace-is":
         return {"engine": d.engine, "converged": True, "pareto_k": d.pareto_k, "effective_draws": d.ess_min}
-    return {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps,
-            "stopped_early": bool(inv.summary.get("sampler", {}).get("stopped_early", False))}
+    quality = {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps,
+               "stopped_early": bool(inv.summary.get("sampler", {}).get("stopped_early", False))}
+    if inv.summary.get("laplace_refused"):
+        quality["laplace_refused"] = inv.summary["laplace_refused"]
+    return quality
 
 
 def _unconverged(quality: dict) -> str:

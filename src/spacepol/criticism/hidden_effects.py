@@ -68,6 +68,7 @@ def sampling(name: str) -> Geometry:
 
 @dataclass
 class Case:
+    """One validation set: the hidden effect (None: a null set) and its values, material, noise, sampling and seed."""
     label: str
     effect: str | None  # None: a null set
     hidden: dict

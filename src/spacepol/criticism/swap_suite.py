@@ -32,6 +32,8 @@ DIFFUSE_CHANGES = ("replace body by lambertian", "replace body by polarized_diff
 
 @dataclass
 class SwapCase:
+    """One set of the swap suite: the effect hidden in the swap base (None: the base alone), material, noise,
+    sampling, seed."""
     label: str
     effect: str | None
     material: str

@@ -105,13 +105,25 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     """The posterior from a Laplace approximation at the mode nearest ``centre``, corrected by Pareto-smoothed
     importance sampling (``laplace``): ``draws`` equally weighted draws resampled from as many weighted ones, and
     PSIS-LOO that accounts for the approximation. None where the approximation cannot be trusted (Pareto k > 0.7,
-    fewer than 400 effective draws, no negative definite Hessian): the caller samples with emcee (``invert``).
-    ``summary["diagnostics"]`` then holds the weights' Pareto k and effective draws; R-hat and tau do not apply."""
+    fewer than 400 effective draws, weights collapsed onto the mode, no negative definite Hessian): the caller samples
+    with emcee (``invert``); ``laplace_fit`` says why. ``summary["diagnostics"]`` holds the weights' Pareto k and
+    effective draws; R-hat and tau do not apply."""
+    return laplace_fit(posterior, centre, seed, draws)[0]
+
+
+NO_LAPLACE = "no negative definite Hessian at the mode (or the log posterior is not finite there)"
+
+
+def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) -> tuple[Result | None, str]:
+    """(``invert_laplace``'s Result, "") where the approximation is trusted, else (None, why not in words: the failed
+    checks with their figures)."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     sample = laplace_importance(posterior, centre, rng, draws=draws)
-    if sample is None or not sample.reliable:
-        return None
+    if sample is None:
+        return None, NO_LAPLACE
+    if not sample.reliable:
+        return None, sample.refusal
     kept = sample.resample(rng, draws)  # the weighted draws may be more than ``draws`` (laplace.MAX_DRAWS)
     names = list(posterior.names)
     centre = np.asarray(centre, float)
@@ -131,7 +143,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     loo_result = importance_loo(log_likelihood, sample.raw_log_weights, lik.labels)
     diagnostics = {"engine": "laplace-is", "rhat_max": None, "ess_min": sample.effective_draws, "tau_max": None,
                    "acceptance": None, "pareto_k": sample.pareto_k}
-    return _inversion(posterior, result, idata, loo_result, diagnostics, seed, start)
+    return _inversion(posterior, result, idata, loo_result, diagnostics, seed, start), ""
 
 
 def result_of(posterior: Posterior, draws: EngineResult, rng: np.random.Generator, seed: int, start: float,

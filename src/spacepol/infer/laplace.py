@@ -104,6 +104,19 @@ class ImportanceSample:
         return _trusted(self.pareto_k, self.effective_draws) and self.width_ratio >= MIN_WIDTH_RATIO
 
     @property
+    def refusal(self) -> str:
+        """The checks of ``reliable`` that failed, with their figures, in words ("" where it is reliable)."""
+        failed = []
+        if not self.pareto_k <= PARETO_K_LIMIT:
+            failed.append(f"Pareto k {self.pareto_k:.2f} > {PARETO_K_LIMIT:g}")
+        if not self.effective_draws >= MIN_EFFECTIVE_DRAWS:
+            failed.append(f"{self.effective_draws:.0f} effective draws < {MIN_EFFECTIVE_DRAWS}")
+        if not self.width_ratio >= MIN_WIDTH_RATIO:
+            failed.append(f"a coordinate's weighted SD {self.width_ratio:.2f} x its Laplace SD < {MIN_WIDTH_RATIO:g}, "
+                          "the weights collapsed onto the mode")
+        return "; ".join(failed)
+
+    @property
     def log_evidence(self) -> tuple[float, float]:
         """(ln Z, its standard error): Z = the mean over the draws of p(theta, y) / q(theta), the unsmoothed weights
         (draws where the posterior is zero count as zero), an unbiased estimate of the evidence, and the delta

@@ -23,6 +23,7 @@ VARIABLES = ("theta_i", "theta_r", "dphi", "phase_deg", "dop_level")
 
 @dataclass
 class ResidualReport:
+    """Standardised residuals per observable and their structure: runs along sweeps, lag-1 correlation, trends."""
     observables: list[str]
     residuals: dict  # observable -> (N,) standardised residuals
     variables: dict  # name -> (N,) values

@@ -14,6 +14,7 @@ from .volume import Volume, VolumeRayleigh
 
 
 class Specular(Effect):
+    """The ``specular`` effect: microfacet reflection with the exact Fresnel Mueller matrix."""
     name = "specular"
     essential = True  # every other lobe and modifier is defined relative to it
     parameters = (
@@ -76,6 +77,7 @@ class Specular(Effect):
 
 
 class Shadowing(Effect):
+    """The ``shadowing`` effect: the paper's empirical shadowing/masking of the specular lobe."""
     name = "shadowing"
     parameters = tuple(
         Parameter(name, "", Uniform(lo, hi), PAPER_CONSTANTS[name], text, fixed=True, physical=(0.0, np.inf))
@@ -101,6 +103,7 @@ class Shadowing(Effect):
 
 
 class Smith(Effect):
+    """The ``smith`` effect: Smith's uncorrelated shadowing-masking for the specular lobe's facet statistics."""
     name = "smith"
     excludes = ("shadowing",)
     requires = ("specular",)
@@ -132,6 +135,7 @@ class Smith(Effect):
 
 
 class Body(Effect):
+    """The ``body`` effect: the paper's depolarized body term, cos(theta_r) rho_d / pi."""
     name = "body"
     parameters = (
         Parameter("rho_d", "", Uniform(0.0, 1.0), 0.1, "Kubelka-Munk body reflectance rho_d (eq 12)", physical=(0.0, 1.0)),
@@ -153,6 +157,7 @@ class Body(Effect):
 
 
 class PolarizedDiffuse(Effect):
+    """The ``polarized_diffuse`` effect: refracted in, depolarized, refracted out (Fresnel transmission twice)."""
     name = "polarized_diffuse"
     parameters = (
         Parameter("rho_pd", "", Uniform(0.0, 1.0), 0.1, "albedo of the subsurface Lambertian light", physical=(0.0, 1.0)),
@@ -193,6 +198,7 @@ def _transmission(n, k, cos_t):
 
 
 class Subsurface(Effect):
+    """The ``subsurface`` effect: a Lambertian material under a smooth transparent interface (SCATMECH's model)."""
     name = "subsurface"
     parameters = (
         Parameter("rho_s", "", Uniform(0.0, 1.0), 0.3, "albedo of the diffusely scattering material under the surface",
@@ -220,6 +226,7 @@ class Subsurface(Effect):
 
 
 class Depolarization(Effect):
+    """The ``depolarization`` effect: a fraction of the specular lobe depolarized, its intensity kept."""
     name = "depolarization"
     parameters = (
         Parameter("d_spec", "", Uniform(0.0, 1.0), 0.1, "fraction of the specular lobe depolarized", physical=(0.0, 1.0)),
@@ -243,6 +250,7 @@ class Depolarization(Effect):
 
 
 class Anisotropy(Effect):
+    """The ``anisotropy`` effect: slope widths along two turned axes in place of sigma."""
     name = "anisotropy"
     parameters = (
         Parameter("sigma_x", "", Uniform(0.02, 0.8), 0.2, "slope standard deviation along the surface x' axis", physical=(1e-6, np.inf)),
@@ -271,6 +279,7 @@ class Anisotropy(Effect):
 
 
 class GGX(Effect):
+    """The ``ggx`` effect: Trowbridge-Reitz facet slopes in place of Gaussian ones."""
     name = "ggx"
     requires = ("specular",)
     description = (
@@ -285,6 +294,7 @@ class GGX(Effect):
 
 
 class OxideLayer(Effect):
+    """The ``oxide_layer`` effect: a thin transparent film on the facets (Airy reflection coefficients)."""
     name = "oxide_layer"
     parameters = (
         Parameter("thickness_um", "um", Uniform(0.0, 1.0), 0.05, "film thickness", physical=(0.0, np.inf)),
@@ -316,6 +326,7 @@ class OxideLayer(Effect):
 
 
 class AngleOffset(Effect):
+    """The ``angle_offset`` effect: a goniometer zero error added to both polar angles."""
     name = "angle_offset"
     parameters = (
         Parameter("delta_deg", "deg", Uniform(-3.0, 3.0), 0.0, "goniometer zero error added to theta_i and theta_r", physical=(-89.0, 89.0)),
@@ -331,6 +342,7 @@ class AngleOffset(Effect):
 
 
 class Extinction(Effect):
+    """The ``extinction`` effect: an analyser with a finite extinction ratio (S1, S2, S3 scaled)."""
     name = "extinction"
     parameters = (
         Parameter("e", "", Uniform(0.5, 1.0), 0.95, "analyser efficiency: measured DOP = e x true DOP", physical=(0.0, 1.0)),
@@ -351,6 +363,7 @@ class Extinction(Effect):
 
 
 class DopBias(Effect):
+    """The ``dop_bias`` effect: the Rician bias of a DOP estimated from noisy Stokes parameters."""
     name = "dop_bias"
     parameters = (
         Parameter("bias", "", Uniform(0.0, 0.2), 0.02, "noise floor of the DOP estimator", physical=(0.0, 1.0)),
@@ -368,6 +381,7 @@ class DopBias(Effect):
 
 
 class Lambertian(Effect):
+    """The ``lambertian`` effect: depolarized Lambertian reflection, rho_l / pi."""
     name = "lambertian"
     parameters = (
         Parameter("rho_l", "", Uniform(0.0, 1.0), 0.1, "albedo of the depolarized Lambertian diffuse light", physical=(0.0, 1.0)),

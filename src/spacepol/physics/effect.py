@@ -187,8 +187,9 @@ class Effect:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if not cls.__dict__.get("__doc__") and cls.__dict__.get("description"):
-            cls.__doc__ = f"The ``{cls.name}`` effect. {cls.description}"  # one text for help(), docs and `effects`
+        if cls.__dict__.get("description"):  # one text for help(), docs and `effects`: the summary, then the physics
+            own = (cls.__dict__.get("__doc__") or "").strip()
+            cls.__doc__ = f"{own}\n\n{cls.description}" if own else f"The ``{cls.name}`` effect. {cls.description}"
 
     # lmfit-style composition: effect + effect -> Model. model.py sets _model_type when it defines Model, so this
     # module needs no import of the one that builds on it (the physics package imports both)

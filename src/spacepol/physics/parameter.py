@@ -12,6 +12,8 @@ from ..priors import Fixed, Prior
 
 @dataclass(frozen=True)
 class Parameter:
+    """A model parameter: name, unit, prior, default, description; ``fixed`` ones are held at the default unless
+    freed, values outside ``physical`` are impossible."""
     name: str
     unit: str
     prior: Prior

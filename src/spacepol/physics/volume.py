@@ -231,6 +231,7 @@ class SingleScattering(Effect):
 
 
 class Volume(SingleScattering):
+    """The ``volume`` effect: first-order volume scattering with the Code-Whitney phase matrix under the interface."""
     name = "volume"
     parameters = (
         Parameter("w_vol", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the volume scatterers (scattering over "
@@ -271,6 +272,7 @@ class Volume(SingleScattering):
 
 
 class VolumeRayleigh(SingleScattering):
+    """The ``volume_rayleigh`` effect: first-order volume scattering with the Rayleigh phase matrix."""
     name = "volume_rayleigh"
     parameters = (
         Parameter("w_ray", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the small (Rayleigh) scatterers",

@@ -50,6 +50,8 @@ def stereographic_zeta(zenith_deg, azimuth_deg):
 
 @dataclass(frozen=True)
 class BerryDennisLeeSky:
+    """Skylight polarization with the four neutral points (Berry, Dennis & Lee 2004): maximum DOP ``p_max``, each
+    neutral point ``delta_deg`` from the sun or anti-sun."""
     p_max: float = 0.8
     delta_deg: float = 20.0  # angular distance of each neutral point from the sun (anti-sun)
     name = "berry-dennis-lee"

@@ -26,6 +26,7 @@ from ..errors import UnknownNameError
 
 @dataclass(frozen=True)
 class Projection:
+    """A map of the sky hemisphere: radius on the map from the zenith angle and back, and its radial scale."""
     name: str
     label: str
 

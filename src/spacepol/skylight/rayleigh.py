@@ -23,6 +23,7 @@ from .directions import angle_of_polarization, unit_vector
 
 @dataclass(frozen=True)
 class RayleighSky:
+    """Single-scattering Rayleigh skylight polarization, scaled to a maximum DOP ``p_max``."""
     p_max: float = 1.0
     name = "rayleigh"
 

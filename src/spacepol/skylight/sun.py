@@ -30,6 +30,7 @@ def _note_once(key: str, text: str) -> None:
 
 @dataclass(frozen=True)
 class SunPosition:
+    """The sun's zenith and azimuth (degrees, azimuth east of north) at a UTC time."""
     zenith_deg: float
     azimuth_deg: float  # east of north
     time_utc: str

@@ -57,15 +57,15 @@ class Laplace(Engine):
 
     def result(self, posterior, seed: int = 0, progress: bool = False, chain=None, draws: int = 2000, **options):
         """``inversion.invert_laplace`` at the optimum the start-point search finds."""
-        from ..inversion import invert_laplace
+        from ..inversion import laplace_fit
         from ..optimum import find_optimum
 
         self.check_options(options)
         _, centre = find_optimum(posterior, np.random.default_rng(seed))
-        result = invert_laplace(posterior, centre, seed=seed, draws=draws)
+        result, refusal = laplace_fit(posterior, centre, seed=seed, draws=draws)
         if result is None:
             raise SpacepolError(f"engine laplace: the Laplace approximation of {posterior.likelihood.model.name} cannot be "
-                                f"trusted here (its importance weights failed their checks); use engine emcee")
+                                f"trusted here ({refusal}); use engine emcee")
         return result
 
 

@@ -8,7 +8,7 @@ import arviz as az
 import numpy as np
 import pytest
 
-from spacepol.infer.inversion import NO_LAPLACE, invert, invert_laplace, laplace_fit
+from spacepol.infer.inversion import invert, invert_laplace, laplace_fit
 from spacepol.infer.laplace import ImportanceSample, importance_loo, laplace_importance
 from spacepol.infer.optimum import find_optimum
 from spacepol.infer.posterior import Posterior

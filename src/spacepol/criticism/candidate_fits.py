@@ -68,8 +68,8 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
     Laplace approximation corrected by importance sampling (``inversion.laplace_fit``), where its checks trust
     it, else emcee (why not: ``summary["laplace_refused"]``; stopped before convergence where the ELPD-LOO of its
     two halves agree, ``elpd_settled``); "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``,
-    ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s instead of 39-48 s
-    (``benchmarks/laplace_vs_emcee.py``)."""
+    ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s
+    instead of 39-48 s (``benchmarks/laplace_vs_emcee.py``)."""
     if posterior_method not in POSTERIOR_METHODS:
         raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
     refusal = None

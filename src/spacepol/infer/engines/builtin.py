@@ -56,7 +56,8 @@ class Laplace(Engine):
         return self.result(posterior, int(rng.integers(2**31)), draws=draws).draws
 
     def result(self, posterior, seed: int = 0, progress: bool = False, chain=None, draws: int = 2000, **options):
-        """``inversion.invert_laplace`` at the optimum the start-point search finds."""
+        """``inversion.laplace_fit`` at the optimum the start-point search finds; where its checks refuse the
+        approximation, one line saying which (the refusal's figures)."""
         from ..inversion import laplace_fit
         from ..optimum import find_optimum
 

@@ -101,7 +101,7 @@ class ImportanceSample:
     def reliable(self) -> bool:
         """Whether the weighted draws stand for the posterior: k <= 0.7, effective draws >= 400, and no coordinate
         narrower than ``MIN_WIDTH_RATIO`` x its Laplace SD in the sampling space (``width_ratio``, the smallest ratio)."""
-        return _trusted(self.pareto_k, self.effective_draws) and self.width_ratio >= MIN_WIDTH_RATIO
+        return not self.refusal
 
     @property
     def refusal(self) -> str:

@@ -145,13 +145,19 @@ def test_ptfe_diagnosis_states_which_effects_improve_elpd(tmp_path):
                   "--wavelength-um", "0.633", "--in-plane", "--json", js, "--out", out)
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads(js.read_text())
-    confirmed = [r for r in report["ranking"] if r["delta_elpd"] is not None]
-    assert len(confirmed) >= 3 and len(report["ranking"]) >= 8
+    ranking = report["ranking"]
+    confirmed = [r for r in ranking if r["delta_elpd"] is not None]
+    # a change whose best fit falls below a refitted change's ELPD-LOO by more than its SE is decided without a refit
+    outranked = [r for r in ranking if r["delta_elpd"] is None and r.get("dominated_by")]
+    assert len(confirmed) >= 1 and len(confirmed) + len(outranked) >= 3 and len(ranking) >= 8
     html = (out / "report.html").read_text()
     assert "Improve ELPD-LOO by more than 2 SE:" in html and "Do not:" in html
+    improve, do_not = html.split("Improve ELPD-LOO by more than 2 SE:")[1].split("Do not:", 1)
     for r in confirmed:  # every refitted effect appears in the statement, on the side its flag says
-        assert r["effect"] in html.split("Improve ELPD-LOO by more than 2 SE:")[1]
         assert r["significant"] == (r["delta_elpd"] > 2 * r["delta_elpd_se"] and r["delta_elpd"] > 4)
+        assert r["change"].split()[-1] in (improve if r["significant"] else do_not)
+    for r in outranked:  # and every change decided without a refit, on the side of those that do not
+        assert r["change"].split()[-1] in do_not.split("not refitted, clearly worse")[1].split("screened out")[0]
 
 
 def test_refits_asked_for_are_skipped_only_where_the_optima_already_decide(monkeypatch):

@@ -122,7 +122,7 @@ def test_a_parameter_whose_posterior_reaches_its_bound_keeps_its_own_coordinates
     assert not {"n", "k", "sigma", "rho_d"} & set(reaching_a_bound(ridge, find_optimum(ridge, np.random.default_rng(0))[1]))
 
 
-@pytest.mark.slow  # 13 s; the fast NUTS check is the prior-only run above
+@pytest.mark.slow  # ~60 s; the fast NUTS check is the prior-only run above
 def test_nuts_and_emcee_reach_the_same_posterior_on_the_ridge():
     """On DOP alone (the k_s/rho_d ridge) both engines' 5/50/95 % quantiles agree within 4 combined Monte-Carlo
     standard errors (from each run's ESS); NUTS takes ~10 leapfrog steps a draw in the logit space.
@@ -131,7 +131,9 @@ def test_nuts_and_emcee_reach_the_same_posterior_on_the_ridge():
     from spacepol.infer.engines.nuts import sample_nuts
 
     post = dop_posterior()
-    a = sample_emcee(post, np.random.default_rng(4), progress=False)
+    # emcee mixes slowly along this band (acceptance 0.19, tau ~100): with seed 4 its R-hat was still 1.02 at the
+    # default cap of 20,000 steps and reached 1.01 at 29,500, so the cap is raised; "not capped" is still required
+    a = sample_emcee(post, np.random.default_rng(4), progress=False, max_steps=60000)
     b = sample_nuts(post, np.random.default_rng(4), progress=False)
     assert not a.info["capped"] and not b.info["capped"]
     assert b.info["leapfrog_per_draw"] < 30

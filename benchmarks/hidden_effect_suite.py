@@ -19,6 +19,7 @@ hidden_effects.json and keeps the others, so one part can be re-measured alone.
 
 import argparse
 import json
+import multiprocessing
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -67,7 +68,7 @@ def _merge(old: list[dict], new: list[dict]) -> list[dict]:
 def run_swaps(jobs: int) -> list[dict]:
     cases = swap_suite()
     rows = []
-    with ProcessPoolExecutor(jobs) as pool:
+    with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn")) as pool:  # a fork can deadlock in JAX
         for k, row in enumerate(pool.map(run_swap_case, cases)):
             rows.append(row)
             chi2 = " -> ".join(f"{c:.2f}" for c in row["chi2_red_per_round"])

@@ -12,6 +12,7 @@ conventions agree); the rounds over the whole library are slow (about 5 min for 
 """
 
 import json
+import multiprocessing
 import subprocess
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -95,7 +96,7 @@ def judge(kind, report) -> dict:
 
 @pytest.mark.slow
 def test_rounds_from_paper_explain_independent_renders(tmp_path):
-    with ProcessPoolExecutor(2) as pool:
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:  # a fork can deadlock in JAX
         results = list(pool.map(_run_set, [(k, nd, nb, s, str(tmp_path)) for k, nd, nb, s in SETS]))
     rows = [judge(kind, report) for kind, report in results]
     for r in rows:

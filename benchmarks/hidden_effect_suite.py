@@ -19,11 +19,10 @@ hidden_effects.json and keeps the others, so one part can be re-measured alone.
 
 import argparse
 import json
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from spacepol._runtime import spawned_pool
 from spacepol.criticism.hidden_effects import run_suite, suite, summarise
 from spacepol.criticism.swap_suite import run_swap_case, summarise_swaps, swap_suite
 from spacepol.io.atomic import save_figure, write_json
@@ -68,7 +67,7 @@ def _merge(old: list[dict], new: list[dict]) -> list[dict]:
 def run_swaps(jobs: int) -> list[dict]:
     cases = swap_suite()
     rows = []
-    with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn")) as pool:  # a fork can deadlock in JAX
+    with spawned_pool(jobs) as pool:
         for k, row in enumerate(pool.map(run_swap_case, cases)):
             rows.append(row)
             chi2 = " -> ".join(f"{c:.2f}" for c in row["chi2_red_per_round"])

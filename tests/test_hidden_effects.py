@@ -64,13 +64,10 @@ def test_swap_cases_reach_noise_through_the_right_changes():
     """Data from specular+smith+lambertian+E, diagnose --rounds 4 from paper (issue 10): >= 10 of the 12
     cases take the shadowing swap and E (or a tied twin) and end at reduced chi^2 < 1.5, and neither
     null set gains an addition. The target was set before the suite was run, as for the renders (6 of 7)."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
+    from spacepol._runtime import spawned_pool
     from spacepol.criticism.swap_suite import run_swap_case, summarise_swaps, swap_suite
 
-    # spawned: a forked child of this JAX-using process deadlocked (0 % CPU for 17 min, session 30)
-    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+    with spawned_pool(2) as pool:
         rows = list(pool.map(run_swap_case, swap_suite()))
     for r in rows:
         print(r["label"], " -> ".join(r["path"]), r["chi2_red_per_round"], r["correct"])

@@ -12,15 +12,14 @@ conventions agree); the rounds over the whole library are slow (about 5 min for 
 """
 
 import json
-import multiprocessing
 import subprocess
 import sys
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
 
 from renders import EXPECTED, HIDDEN, rendered_set
+from spacepol._runtime import spawned_pool
 from spacepol.criticism.swap_suite import shadowing_swapped
 from spacepol.io.measurements import write_table
 
@@ -96,7 +95,7 @@ def judge(kind, report) -> dict:
 
 @pytest.mark.slow
 def test_rounds_from_paper_explain_independent_renders(tmp_path):
-    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:  # a fork can deadlock in JAX
+    with spawned_pool(2) as pool:
         results = list(pool.map(_run_set, [(k, nd, nb, s, str(tmp_path)) for k, nd, nb, s in SETS]))
     rows = [judge(kind, report) for kind, report in results]
     for r in rows:

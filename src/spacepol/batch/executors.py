@@ -51,11 +51,12 @@ def _collect(futures: dict, as_completed, on_done) -> None:
 
 def run_local(jobs, out: str, workers: int, on_done) -> None:
     """Run the jobs on a local pool of ``workers`` spawned processes; ``on_done(row)`` as each finishes."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import as_completed
+
+    from .._runtime import spawned_pool
 
     with _worker_environment():
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        pool = spawned_pool(workers)
     try:
         _collect({pool.submit(run_job, job, out): job for job in jobs}, as_completed, on_done)
     finally:

@@ -13,11 +13,10 @@ process (a fresh worker would not know the file).
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import time
 import zlib
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from typing import Iterator
 
 import numpy as np
@@ -187,11 +186,10 @@ class CandidateFits:
 
     def _open(self):
         if self._pool is None:
-            from .._runtime import configured
+            from .._runtime import configured, spawned_pool
 
-            self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                             initializer=_start_worker,
-                                             initargs=(self.data, self.observables, self.priors, configured(), os.getpid()))
+            self._pool = spawned_pool(self.workers, initializer=_start_worker,
+                                      initargs=(self.data, self.observables, self.priors, configured(), os.getpid()))
         return self._pool
 
     def close(self) -> None:

@@ -231,11 +231,9 @@ def run_suite(cases: list[Case], seed: int = 0, jobs: int = 1, progress: bool = 
     rows = [None] * len(cases)
     tasks = [(i, c, seed) for i, c in enumerate(cases)]
     if jobs > 1:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+        from .._runtime import spawned_pool
 
-        # spawned, not forked: a fork copies JAX's thread pool mid-lock, and the children can wait forever
-        with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with spawned_pool(jobs) as pool:
             done = pool.map(_run_indexed, tasks)
             for k, (i, row) in enumerate(done):
                 rows[i] = row

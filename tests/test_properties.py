@@ -15,6 +15,7 @@ MODELS = [
     "specular+smith+ggx+body",
     "specular+smith+subsurface+volume",
     "specular+shadowing+lambertian+volume_rayleigh",
+    "specular+smith+subsurface+phase_matrix",
 ]
 
 

@@ -1,6 +1,7 @@
 """The changes of a model that diagnose weighs: every addition of a registered effect, every
 replacement of a slot's member by another of the same slot ("replace shadowing by smith",
-"replace body by lambertian"), and every removal of an effect that declares itself removable.
+"replace body by lambertian") or by an effect that declares it may stand in for it (``Effect.substitutes``),
+and every removal of an effect that declares itself removable.
 What an effect may do comes from the effect itself (``Effect.slot``, ``removable``, ``applicable``),
 so a plug-in takes part like a built-in."""
 
@@ -96,6 +97,7 @@ def changes(model: Model, data, names=None) -> list[Change]:
         if cls().applicable(data) is not None:
             continue
         replaced = [e.name for e in model.effects if cls.slot and e.slot == cls.slot] if cls.slot else additions
+        replaced += [e.name for e in model.effects if e.name in cls.substitutes and e.name not in replaced]
         for change in [("add", None)] + [("replace", old) for old in replaced]:
             try:
                 label = f"add {name}" if change[0] == "add" else f"replace {change[1]} by {name}"

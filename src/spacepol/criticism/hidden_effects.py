@@ -46,6 +46,10 @@ HIDDEN_VALUES = {  # per built-in effect: a small and a large value, inside the 
     "subsurface": [{"rho_s": 0.2}, {"rho_s": 0.7}],
     "volume": [{"w_vol": 0.5, "g_vol": 0.3, "pl_vol": 0.8, "pc_vol": 0.0}, {"w_vol": 1.0, "g_vol": -0.2, "pl_vol": 1.0, "pc_vol": 0.3}],
     "volume_rayleigh": [{"w_ray": 0.5}, {"w_ray": 1.0}],
+    "phase_matrix": [{"w_pm": 0.5, "g_pm": 0.3, "n_pm": 1.3, "pm_m22_0": 0.9, "pm_m22_60": 0.6, "pm_m12_60": -0.5,
+                      "pm_m22_120": 0.5, "pm_m12_120": -0.4},
+                     {"w_pm": 1.0, "g_pm": -0.2, "n_pm": 1.25, "pm_m22_0": 0.8, "pm_m22_60": 0.4, "pm_m12_60": -0.8,
+                      "pm_m34_60": 0.3, "pm_m22_120": 0.3, "pm_m12_120": -0.7, "pm_m22_180": 0.5}],
 }
 NOISE = [(0.002, 0.01), (0.01, 0.05)]  # (DOP absolute, BRDF relative): a good lab polarimeter, a field one
 WAVELENGTH_UM = 0.633

@@ -10,6 +10,7 @@ from . import facets, fresnel
 from .effect import Context, Effect, Ratio
 from .parameter import Parameter
 from .shadowing import PAPER_CONSTANTS, paper_shadowing
+from .phase_matrix import PhaseMatrix
 from .volume import Volume, VolumeRayleigh
 
 
@@ -404,5 +405,6 @@ class Lambertian(Effect):
 BUILTIN_EFFECTS = (
     Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
     Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian, Subsurface, Volume, VolumeRayleigh,
+    PhaseMatrix,
 )
 PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

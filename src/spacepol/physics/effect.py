@@ -141,6 +141,7 @@ class Effect:
 
     * ``slot``: the role it plays ("shadowing", "body", "facets"), or None for a pure addition;
       effects of one slot can replace each other ("replace shadowing by smith");
+    * ``substitutes``: other effects it may replace besides its slot's members (a volume lobe for a body term);
     * ``removable``: "remove E" is a sensible change (a shadowing term, a diffuse lobe);
     * ``essential``: the lobe the model is built on (``specular``): never removed or swapped for an
       addition, though it has no slot;
@@ -168,6 +169,7 @@ class Effect:
     reciprocal: bool = True  # does it keep M(i -> r) = Q M(r -> i)^T Q ?
     description: str = ""
     slot: str | None = None
+    substitutes: tuple[str, ...] = ()
     removable: bool = False
     essential: bool = False
     twins: dict = {}

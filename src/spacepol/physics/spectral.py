@@ -18,7 +18,7 @@ from .geometry import Geometry
 from .model import Model, Prediction
 from .parameter import Parameter
 
-SPECTRAL = ("n", "k", "n_film")  # optical constants: they change with wavelength
+SPECTRAL = ("n", "k", "n_film", "n_pm")  # optical constants: they change with wavelength
 DISPERSION_LAWS = ("cauchy",)
 
 

@@ -157,7 +157,7 @@ def rayleigh_phase(cos_theta):
     return 3.0 * (1.0 + cos_theta * cos_theta) / (16.0 * np.pi)
 
 
-def single_scattering(ctx: Context, albedo, phase_matrix, depolarization=(0.0, 0.0)):
+def single_scattering(ctx: Context, albedo, phase_matrix, depolarization=(0.0, 0.0), index=None):
     """The lobe of light scattered once under the interface: ``phase_matrix(cos Theta)`` -> 4 x 4 nested lists in the
     scattering plane's (parallel, perpendicular) basis; (4, 4, ...) with ``ctx.mueller``, else the Stokes vector
     for unpolarized light (the matrix's first column).
@@ -168,9 +168,11 @@ def single_scattering(ctx: Context, albedo, phase_matrix, depolarization=(0.0, 0
 
     ``depolarization`` = (linear, circular): SCATMECH's depoll, depolc, the share of the light's linear and
     circular polarization lost on its path in and out (further scattering along the way), split between the two
-    paths by their lengths: diag(1, 1 - d mu_r'/(mu_i' + mu_r'), ...) on the way in, mu_i' on the way out."""
+    paths by their lengths: diag(1, 1 - d mu_r'/(mu_i' + mu_r'), ...) on the way in, mu_i' on the way out.
+
+    ``index``: the interface's (n, k); None for the facets' n and k."""
     geo = ctx.geometry
-    n, k = ctx["n"], ctx["k"]
+    n, k = (ctx["n"], ctx["k"]) if index is None else index
     k_i, k_r = _components(geo.k_i), _components(geo.k_r)
     d_in, mu_in = _internal_direction(k_i, n, into=True)
     d_out, mu_out = _internal_direction(k_r, n, into=False)

@@ -1,0 +1,87 @@
+"""The ``phase_matrix`` effect: light scattered once inside a porous material, with a free-form Mueller phase
+matrix that is physically realizable over its whole prior (``constrained_phase``), after NIST SCATMECH's
+``First_Diffuse_BRDF_Model`` with ``Constrained_Phase_Function`` (Germer, Proc. SPIE 10655, 1065504 (2018)):
+
+    M = w / (n'^2 (mu_i' + mu_r')) D_out T(theta_r) R_out HG(g; Theta) P(Theta) R_in T(theta_i) D_in,
+
+with n' the interface's own (real) index, which may differ from the facets' (a sintered powder's effective
+surface index lies between 1 and its grains'), mu' the internal cosines, P the reduced phase matrix splined
+between its values at 0, 60, 120 and 180 deg of internal scattering angle Theta, HG the Henyey-Greenstein phase
+function of asymmetry g, w the single-scattering albedo, and D the linear and circular depolarization along the
+way in and out (SCATMECH's depoll, depolc), shared between the paths by their lengths.
+"""
+
+from __future__ import annotations
+
+import jax.numpy as jnp
+import numpy as np
+
+from ..priors import Uniform
+from . import constrained_phase
+from .effect import Context
+from .parameter import Parameter
+from .volume import SingleScattering, henyey_greenstein, single_scattering
+
+PREFIX = "pm_"
+SHAPE_NAMES = tuple(PREFIX + name for name, _ in constrained_phase.COORDINATES)
+
+
+def circular_depolarization(linear, share):
+    """SCATMECH's depolc from the linear one and a share in [0, 1] of its realizable bound: a leg's
+    diag(1, 1 - l, 1 - l, 1 - c) is a physical depolarizer only when c <= 2 l (its coherency eigenvalue
+    (2 l - c) / 4 >= 0), and c <= 1."""
+    return share * jnp.minimum(1.0, 2.0 * linear)
+
+
+class PhaseMatrix(SingleScattering):
+    """The ``phase_matrix`` effect: first-order volume scattering with a free-form, realizable phase matrix under
+    an interface of its own index."""
+    name = "phase_matrix"
+    requires = ()
+    substitutes = ("subsurface",)  # a volume lobe may carry what a multiple-scattering body term fitted
+    parameters = (
+        Parameter("w_pm", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the volume scatterers",
+                  physical=(0.0, 1.0)),
+        Parameter("g_pm", "", Uniform(-0.9, 0.9), 0.0, "Henyey-Greenstein asymmetry of the phase function (> 0 forward)",
+                  physical=(-0.999, 0.999)),
+        Parameter("n_pm", "", Uniform(1.0, 2.0), 1.3, "real index of the interface the light crosses in and out "
+                  "(a porous material's effective surface index)", physical=(1.0, np.inf)),
+        Parameter("dl_pm", "", Uniform(0.0, 1.0), 0.0, "share of the linear polarization lost on the paths in and "
+                  "out (SCATMECH's depoll)", physical=(0.0, 1.0)),
+        Parameter("fc_pm", "", Uniform(0.0, 1.0), 0.0, "circular polarization lost on the paths in and out "
+                  "(SCATMECH's depolc) as a share of its realizable bound min(1, 2 dl_pm)", physical=(0.0, 1.0)),
+        *(Parameter(PREFIX + name, "", Uniform(-1.0, 1.0), 0.0, f"phase-matrix shape coordinate: {meaning} (the value "
+                    "itself where the spline stays realizable, drawn towards the depolarizer where it would not)",
+                    physical=(-1.0, 1.0))
+          for name, meaning in constrained_phase.COORDINATES),
+    )
+    description = (
+        "Light scattered once inside a porous material (NIST SCATMECH's First_Diffuse_BRDF_Model with the "
+        "Constrained_Phase_Function; Germer, SPIE 10655, 2018): it refracts in through an interface of its own "
+        "index n_pm, scatters once with a free-form reduced Mueller phase matrix (m22, m33, m44, m12, m34 splined "
+        "between 0, 60, 120 and 180 deg of internal scattering angle) times a Henyey-Greenstein phase function "
+        "(g_pm), and refracts out; f = w_pm D T(theta_r) P(Theta) T(theta_i) D / (n_pm^2 (mu_i' + mu_r')), D the "
+        "linear (dl_pm) and circular depolarization along the paths. The 14 pm_* shape coordinates lie in [-1, 1] "
+        "and every point of that box gives a phase matrix that is physically realizable (Cloude coherency "
+        "eigenvalues >= 0) at every scattering angle. Reciprocal."
+    )
+    intensity = "w_pm"
+    neutral = {"w_pm": 0.0}
+
+    @staticmethod
+    def nodes(values) -> constrained_phase.NodeValues:
+        """The realizable node values of the phase matrix for parameter values (a dict or the context)."""
+        return constrained_phase.realizable_nodes([values[name] for name in SHAPE_NAMES])
+
+    def phase_matrix(self, ctx: Context, cos_theta):
+        reduced = constrained_phase.reduced_matrix(self.nodes(ctx), cos_theta)
+        phase = henyey_greenstein(ctx["g_pm"], cos_theta)
+        return [[v if isinstance(v, float) and v == 0.0 else v * phase for v in row] for row in reduced]
+
+    def depolarization(self, ctx: Context):
+        return (ctx["dl_pm"], circular_depolarization(ctx["dl_pm"], ctx["fc_pm"]))
+
+    def lobe(self, ctx: Context):
+        n = ctx["n_pm"]
+        return single_scattering(ctx, ctx["w_pm"], lambda cos_theta: self.phase_matrix(ctx, cos_theta),
+                                 self.depolarization(ctx), index=(n, 0.0 * n))

@@ -1,8 +1,9 @@
-"""Speed of `volume` (first-order volume scattering under the interface), in one process, against NIST SCATMECH's
-First_Diffuse_BRDF_Model (pySCATMECH, C++ called once per geometry from Python: the independent implementation
-the tests compare with) and against `subsurface`, the other lobe under the same interface.
+"""Speed of `volume` and `phase_matrix` (first-order volume scattering under the interface), in one process, against
+NIST SCATMECH's First_Diffuse_BRDF_Model (pySCATMECH, C++ called once per geometry from Python: the independent
+implementation the tests compare with) and against `subsurface`, the other lobe under the same interface.
 
-Cases: the full Mueller matrix of `specular+volume` and `specular+subsurface` for 64 parameter sets x 600 geometries
+Cases: the full Mueller matrix of `specular+volume`, `specular+phase_matrix` (one draw from its prior) and
+`specular+subsurface` for 64 parameter sets x 600 geometries
 (random over the hemisphere, a third in the plane), and SCATMECH's matrix at one parameter set over the same
 geometries. Evaluations per second (sets x geometries), medians of repeats, the load average, and the largest
 difference from SCATMECH (a check, not only a timing).
@@ -50,10 +51,15 @@ def main() -> None:
     c = CASE
     values = {"n": c["n"], "k": c["k"], "sigma": 0.2, "ks": 0.0, "w_vol": _albedo(c["la"], c["k"]), "g_vol": c["g"],
               "pl_vol": c["pl"], "pc_vol": c["pc"], "s_vol": c["s"], "dl_vol": 0.0, "dc_vol": 0.0, "rho_s": 0.5}
+    from spacepol.physics.phase_matrix import PhaseMatrix
+
+    rng = np.random.default_rng(0)
+    phase = {p.name: rng.uniform(*p.prior.bounds) for p in PhaseMatrix.parameters}
+    values.update(phase)
     batch = {k: np.full(SETS, v) for k, v in values.items()}
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}; {SETS} sets x {geometry.size} geometries")
     rates = {}
-    for spec in ("specular+volume", "specular+subsurface"):
+    for spec in ("specular+volume", "specular+phase_matrix", "specular+subsurface"):
         model = Model.from_string(spec)
         own = {p.name for p in model.parameters}
         params = {k: v for k, v in batch.items() if k in own}
@@ -72,12 +78,13 @@ def main() -> None:
 
     seconds = _median_seconds(scatmech, 3)
     rate = geometry.size / seconds
-    ours = Model.from_string("specular+volume").evaluate({k: v for k, v in values.items() if k != "rho_s"}, geometry,
-                                                          mueller=True).mueller
+    volume = Model.from_string("specular+volume")
+    ours = volume.evaluate({p.name: values[p.name] for p in volume.parameters}, geometry, mueller=True).mueller
     theirs = scatmech()
     print(f"  SCATMECH (pySCATMECH, one geometry per call) {seconds * 1e3:8.2f} ms for {geometry.size}, {rate / 1e6:7.3f} M evaluations/s")
     print(f"  volume / SCATMECH {rates['specular+volume'] / rate:8.0f}x; volume / subsurface "
-          f"{rates['specular+volume'] / rates['specular+subsurface']:.2f}x")
+          f"{rates['specular+volume'] / rates['specular+subsurface']:.2f}x; phase_matrix / volume "
+          f"{rates['specular+phase_matrix'] / rates['specular+volume']:.2f}x")
     print(f"  largest difference from SCATMECH: M11 {np.max(np.abs(ours[0, 0] / theirs[0, 0] - 1)):.1e} relative, "
           f"m_ij {np.max(np.abs(ours / ours[0, 0] - theirs / theirs[0, 0])):.1e}")
 

@@ -19,7 +19,7 @@ from .elpd_settled import settled
 from .engines.emcee_sampler import ball, default_walkers, sample_emcee
 from .identifiability import identifiability
 from .inference_data import batched, to_inference_data
-from .laplace import importance_loo, laplace_importance
+from .laplace import importance_loo, laplace_importance, scale_ridge
 from .posterior import Posterior
 from .engine_result import EngineResult
 from .result import Result
@@ -118,6 +118,9 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
     """(``invert_laplace``'s Result, "") where the approximation is trusted, else (None, why not in words: the failed
     checks with their figures)."""
     start = time.perf_counter()
+    ridge = scale_ridge(posterior)
+    if ridge:
+        return None, ridge
     rng = np.random.default_rng(seed)
     sample = laplace_importance(posterior, centre, rng, draws=draws)
     if sample is None:

@@ -136,6 +136,21 @@ class ImportanceSample:
         return np.minimum(np.searchsorted(cumulative, positions), len(self.theta) - 1)
 
 
+def scale_ridge(posterior: Posterior) -> str:
+    """Why no Gaussian can stand for this posterior by construction, in words ("" where none is known): every fitted
+    observable is a ratio of intensities (DOP, q and u, m_ij: ``Observable.scale_free``) and two or more free
+    parameters scale lobes (``Effect.intensity``), so the data see only their ratios and the posterior is a ridge
+    along their common scale, cut only by the priors."""
+    likelihood = posterior.likelihood
+    free = set(posterior.names)
+    scales = [e.intensity for e in likelihood.model.effects if e.intensity in free]
+    if len(scales) < 2 or not all(o.scale_free for o in likelihood.objects):
+        return ""
+    return (f"the fitted observables ({', '.join(o.name for o in likelihood.objects)}) are ratios of intensities, so they "
+            f"see {', '.join(scales)} only through their ratios: the posterior is a ridge along their common scale, "
+            "which a Gaussian at the mode cannot hold")
+
+
 def _polish_mode(log_prob_z, z0: np.ndarray) -> np.ndarray:
     """The maximum of the batched log density nearest ``z0`` (L-BFGS, central-difference gradients: 2D + 1 rows
     per call)."""

@@ -194,3 +194,17 @@ def test_a_shape_coordinate_outside_its_range_is_one_line_naming_it():
 def test_shape_names_are_the_effects_parameters():
     names = [p.name for p in PhaseMatrix.parameters]
     assert set(SHAPE_NAMES) <= set(names) and len(SHAPE_NAMES) == 14
+
+
+def test_diagnose_weighs_it_as_an_addition_and_in_place_of_volume_or_subsurface():
+    """The candidate library holds it three ways on PTFE-like models; negative control: a model without either term
+    offers only the addition."""
+    from spacepol.criticism.changes import changes
+    from spacepol.io import read_measurements
+    from spacepol.paths import bundled
+
+    data = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
+    labels = {c.label for c in changes(Model.from_string("specular+smith+subsurface+volume"), data)}
+    assert {"add phase_matrix", "replace volume by phase_matrix", "replace subsurface by phase_matrix"} <= labels
+    plain = {c.label for c in changes(Model.from_string("paper"), data) if "phase_matrix" in c.label}
+    assert plain == {"add phase_matrix"}

@@ -26,6 +26,7 @@ first leave K is kept as it is), and it is one-to-one, so every point of the box
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import reduce
 
 import jax.numpy as jnp
 import numpy as np
@@ -168,7 +169,7 @@ def gauge(a2, a3, a4, b1, b2):
 def nodes_gauge(nodes: NodeValues):
     """The largest gauge over the four nodes."""
     values = [gauge(*(e[j] for e in nodes.elements())) for j in range(4)]
-    return _max(values)
+    return reduce(jnp.maximum, values)
 
 
 def spline_gauge(nodes: NodeValues):
@@ -177,14 +178,9 @@ def spline_gauge(nodes: NodeValues):
     for row in CONTROL_POINTS:
         point = [sum(float(w) * y for w, y in zip(row, e) if abs(w) > 1e-13) for e in nodes.elements()]
         values.append(gauge(*point))
-    return _max(values)
+    return reduce(jnp.maximum, values)
 
 
-def _max(values):
-    out = values[0]
-    for v in values[1:]:
-        out = jnp.maximum(out, v)
-    return out
 
 
 def realizable_nodes(u) -> NodeValues:
@@ -200,9 +196,9 @@ def realizable_nodes(u) -> NodeValues:
     return nodes.scaled(factor)
 
 
-def reduced_matrix(nodes: NodeValues, cos_theta):
-    """The reduced phase matrix (4 x 4 nested lists, 0.0 where structurally zero) at the scattering angles'
-    cosines, in the scattering plane's (parallel, perpendicular) basis."""
+def phase_matrix(nodes: NodeValues, phase, cos_theta):
+    """The phase matrix: the reduced one times the scalar phase function ``phase`` (4 x 4 nested lists, 0.0 where
+    structurally zero) at the scattering angles' cosines, in the scattering plane's (parallel, perpendicular) basis."""
     theta = jnp.arccos(jnp.clip(cos_theta, -1.0, 1.0))
-    a2, a3, a4, b1, b2 = nodes.at(theta)
-    return [[1.0, b1, 0.0, 0.0], [b1, a2, 0.0, 0.0], [0.0, 0.0, a3, b2], [0.0, 0.0, -b2, a4]]
+    a2, a3, a4, b1, b2 = (v * phase for v in nodes.at(theta))
+    return [[phase, b1, 0.0, 0.0], [b1, a2, 0.0, 0.0], [0.0, 0.0, a3, b2], [0.0, 0.0, -b2, a4]]

@@ -20,7 +20,7 @@ from ..priors import Uniform
 from . import constrained_phase
 from .effect import Context
 from .parameter import Parameter
-from .volume import SingleScattering, henyey_greenstein, single_scattering
+from .volume import SingleScattering, henyey_greenstein
 
 PREFIX = "pm_"
 SHAPE_NAMES = tuple(PREFIX + name for name, _ in constrained_phase.COORDINATES)
@@ -74,14 +74,11 @@ class PhaseMatrix(SingleScattering):
         return constrained_phase.realizable_nodes([values[name] for name in SHAPE_NAMES])
 
     def phase_matrix(self, ctx: Context, cos_theta):
-        reduced = constrained_phase.reduced_matrix(self.nodes(ctx), cos_theta)
-        phase = henyey_greenstein(ctx["g_pm"], cos_theta)
-        return [[v if isinstance(v, float) and v == 0.0 else v * phase for v in row] for row in reduced]
+        return constrained_phase.phase_matrix(self.nodes(ctx), henyey_greenstein(ctx["g_pm"], cos_theta), cos_theta)
 
     def depolarization(self, ctx: Context):
         return (ctx["dl_pm"], circular_depolarization(ctx["dl_pm"], ctx["fc_pm"]))
 
-    def lobe(self, ctx: Context):
-        n = ctx["n_pm"]
-        return single_scattering(ctx, ctx["w_pm"], lambda cos_theta: self.phase_matrix(ctx, cos_theta),
-                                 self.depolarization(ctx), index=(n, 0.0 * n))
+    def index(self, ctx: Context):
+        """The interface's own real index: (n_pm, 0)."""
+        return (ctx["n_pm"], 0.0 * ctx["n_pm"])

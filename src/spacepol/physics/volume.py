@@ -225,11 +225,15 @@ class SingleScattering(Effect):
         """(linear, circular) shares of polarization lost on the paths in and out; default none."""
         return (0.0, 0.0)
 
+    def index(self, ctx):
+        """The interface's (n, k); default None, the facets' n and k."""
+        return None
+
     def lobe(self, ctx):
         """The once-scattered lobe under the interface: Fresnel transmission in, the phase matrix, transmission out,
         over (mu_i' + mu_r')."""
         return single_scattering(ctx, ctx[self.intensity], lambda cos_theta: self.phase_matrix(ctx, cos_theta),
-                                 self.depolarization(ctx))
+                                 self.depolarization(ctx), self.index(ctx))
 
 
 class Volume(SingleScattering):

@@ -148,8 +148,8 @@ def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0
     """Sample the posterior of ``model`` (an effect list, a preset or a Model) on ``data`` (a Dataset or a file path) and return its Result.
 
     ``engine``: a sampler of the engine registry: ``emcee`` (affine-invariant ensemble, the default), ``laplace`` (a
-    Laplace approximation at the optimum corrected by importance sampling; an error where its weights cannot be
-    trusted), ``nuts``, an entry point of group ``spacepol.engines`` or a file ``path/to/engine.py:Name``.
+    Laplace approximation at the optimum corrected by importance sampling; emcee where its checks refuse it, and the
+    summary says so: ``diagnostics.engine`` and ``laplace_refused``), ``nuts``, an entry point of group ``spacepol.engines`` or a file ``path/to/engine.py:Name``.
     ``walkers`` and ``steps`` are emcee's (``walkers``, ``max_steps``); ``engine_options`` go to the engine's ``run``.
     With ``out`` the run is kept in that folder as ``invert-mcmc run`` keeps it: for a resumable engine (emcee) the
     chain (an interrupted call continues with the same arguments; ``restart`` starts afresh and keeps the old chain

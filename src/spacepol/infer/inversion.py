@@ -24,6 +24,7 @@ from .posterior import Posterior
 from .engine_result import EngineResult
 from .result import Result
 from .sampling_space import SamplingSpace
+from .spread_check import spread_check
 
 
 def fingerprint(posterior: Posterior, walkers: int, seed: int, space: str = SamplingSpace.family) -> str:
@@ -105,7 +106,8 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     """The posterior from a Laplace approximation at the mode nearest ``centre``, corrected by Pareto-smoothed
     importance sampling (``laplace``): ``draws`` equally weighted draws resampled from as many weighted ones, and
     PSIS-LOO that accounts for the approximation. None where the approximation cannot be trusted (Pareto k > 0.7,
-    fewer than 400 effective draws, weights collapsed onto the mode, no negative definite Hessian): the caller samples
+    fewer than 400 effective draws, weights collapsed onto the mode, emcee walkers started inside the draws spreading
+    beyond them (``spread_check``), no negative definite Hessian): the caller samples
     with emcee (``invert``); ``laplace_fit`` says why. ``summary["diagnostics"]`` holds the weights' Pareto k and
     effective draws; R-hat and tau do not apply."""
     return laplace_fit(posterior, centre, seed, draws)[0]
@@ -127,6 +129,10 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
         return None, NO_LAPLACE
     if not sample.reliable:
         return None, sample.refusal
+    # its own stream, so the draws kept below are those of a run without the check
+    spread = spread_check(posterior, sample, rng.spawn(1)[0])
+    if spread.refusal:
+        return None, spread.refusal
     kept = sample.resample(rng, draws)  # the weighted draws may be more than ``draws`` (laplace.MAX_DRAWS)
     names = list(posterior.names)
     centre = np.asarray(centre, float)
@@ -134,7 +140,8 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
     best = centre if centre_value >= sample.log_prob.max() else sample.theta[int(np.argmax(sample.log_prob))]
     log_z, log_z_error = sample.log_evidence  # importance sampling's evidence, trusted where the weights are
     info = {"engine": "laplace-is", "draws": len(sample.theta), "pareto_k": sample.pareto_k, "effective_draws": sample.effective_draws,
-            "proposal": sample.proposal, "log_evidence": log_z, "log_evidence_error": log_z_error}
+            "proposal": sample.proposal, "log_evidence": log_z, "log_evidence_error": log_z_error,
+            "spread_check": spread.to_json()}
     result = EngineResult(method="laplace-is", model=posterior.likelihood.model.name, names=names,
                     best=dict(zip(names, map(float, best))), objective=-float(max(centre_value, sample.log_prob.max())),
                     objective_name="negative_log_posterior", n_evaluations=posterior.n_evaluations,
@@ -145,7 +152,7 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
     log_likelihood = batched(posterior.log_prob_pointwise, sample.theta, lik.batch_sets)
     loo_result = importance_loo(log_likelihood, sample.raw_log_weights, lik.labels)
     diagnostics = {"engine": "laplace-is", "rhat_max": None, "ess_min": sample.effective_draws, "tau_max": None,
-                   "acceptance": None, "pareto_k": sample.pareto_k}
+                   "acceptance": None, "pareto_k": sample.pareto_k, "sd_growth_max": spread.widest[1]}
     return _inversion(posterior, result, idata, loo_result, diagnostics, seed, start), ""
 
 

@@ -45,28 +45,33 @@ class Emcee(Engine):
 
 
 class Laplace(Engine):
-    """A Laplace approximation at the posterior's optimum, corrected by Pareto-smoothed importance sampling; refused
-    (one line) where the weights fail their checks (Pareto k, effective draws, width): then use emcee."""
+    """A Laplace approximation at the posterior's optimum, corrected by importance sampling; where its checks refuse
+    it (Pareto k, effective draws, width, the walkers' spread), emcee samples instead and the Result says so
+    (``summary["diagnostics"]["engine"]`` names what ran, ``summary["laplace_refused"]`` why)."""
 
     name, kind = "laplace", SAMPLER
-    description = "Laplace approximation at the optimum corrected by importance sampling; fast where it can be trusted"
+    description = "Laplace approximation at the optimum corrected by importance sampling; emcee where it cannot be trusted"
 
     def run(self, posterior, rng, draws: int = 2000, progress: bool = False):
-        """Equally weighted draws resampled from the importance-weighted ones."""
-        return self.result(posterior, int(rng.integers(2**31)), draws=draws).draws
+        """Equally weighted draws resampled from the importance-weighted ones (emcee's where refused)."""
+        return self.result(posterior, int(rng.integers(2**31)), draws=draws, progress=progress).draws
 
     def result(self, posterior, seed: int = 0, progress: bool = False, chain=None, draws: int = 2000, **options):
         """``inversion.laplace_fit`` at the optimum the start-point search finds; where its checks refuse the
-        approximation, one line saying which (the refusal's figures)."""
-        from ..inversion import laplace_fit
+        approximation, one line saying which (the refusal's figures) and ``inversion.invert`` from that optimum."""
+        from ..inversion import invert, laplace_fit
         from ..optimum import find_optimum
 
         self.check_options(options)
         _, centre = find_optimum(posterior, np.random.default_rng(seed))
         result, refusal = laplace_fit(posterior, centre, seed=seed, draws=draws)
-        if result is None:
-            raise SpacepolError(f"engine laplace: the Laplace approximation of {posterior.likelihood.model.name} cannot be "
-                                f"trusted here ({refusal}); use engine emcee")
+        if result is not None:
+            return result
+        if progress:
+            print(f"  the Laplace approximation cannot be trusted here ({refusal}): sampling with emcee",
+                  file=sys.stderr, flush=True)
+        result = invert(posterior, seed=seed, progress=progress, centre=centre, backend_path=chain)
+        result.summary["laplace_refused"] = refusal
         return result
 
 

@@ -303,10 +303,11 @@ def synth(model, values: dict | None = None, geometry=None, *, noise_dop: float 
                    source=str(out) if out is not None else "spacepol synth")
 
 
-def calibrate(model, priors: dict, geometry, *, engine: str = "emcee", replicates: int = 100, seed: int = 0,
+def calibrate(model, priors: dict, geometry, *, engine="emcee", replicates: int = 100, seed: int = 0,
               engine_options: dict | None = None, noise_dop: float = 0.01, noise_brdf: float = 0.05,
               mueller_noise: float | None = None, likelihood_noise_scale: float = 1.0, progress: bool = False):
-    """Simulation-based calibration of a sampling ``engine`` (``infer.calibration``): ``replicates`` truths from
+    """Simulation-based calibration of a sampling ``engine`` (a registry name or an ``Engine``;
+    ``infer.calibration``): ``replicates`` truths from
     ``priors`` ({name: Prior}; the model's defaults for the rest), data simulated at ``geometry`` (a Geometry, a
     Dataset or a file of geometries) with Gaussian noise of known size, one run each. Returns a ``Calibration``:
     coverage of the 50 % and 90 % intervals, rank histograms and their figure, ``calibrated``, ``failures``."""

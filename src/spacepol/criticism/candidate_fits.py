@@ -22,6 +22,7 @@ from typing import Iterator
 import numpy as np
 
 from ..infer import elpd_settled
+from ..infer.engines.base import SAMPLER, Engine
 from ..infer.inversion import invert, laplace_fit
 from ..infer.optimum import multistart, screen_optimum
 from ..infer.posterior import Posterior
@@ -81,6 +82,30 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
     if refusal:  # why emcee: the Laplace approximation's failed checks
         inv.summary["laplace_refused"] = refusal
     return inv
+
+
+class DiagnosePosterior(Engine):
+    """diagnose's posterior of one model as a sampler (for calibration): the optimum of ``find_optimum``, then
+    ``fit_for_elpd`` (Laplace-IS where its checks trust it, else emcee stopped where its ELPD-LOO settles).
+    ``ran`` lists, per call, the engine that gave the draws."""
+
+    name, kind = "diagnose-posterior", SAMPLER
+    description = "diagnose's default posterior: Laplace-IS where trusted, else emcee"
+
+    def __init__(self, variant: str | None = None, max_steps: int = 8000):
+        super().__init__(variant)
+        self.max_steps = max_steps
+        self.ran: list[str] = []
+
+    def run(self, posterior, rng, progress: bool = False):
+        """The Result's draws; the engine that ran is appended to ``ran``."""
+        from ..infer.optimum import find_optimum
+
+        seed = int(rng.integers(2**31))
+        _, centre = find_optimum(posterior, np.random.default_rng(seed))
+        inv = fit_for_elpd(posterior, centre, seed, self.max_steps)
+        self.ran.append(inv.summary["diagnostics"]["engine"])
+        return inv.draws
 
 
 def _screen(post, change, base_optimum: dict, evaluations: int, seed: int) -> tuple[float, dict]:

@@ -24,7 +24,7 @@ from scipy import stats
 from ..io.dataset import Dataset
 from ..physics.geometry import Geometry
 from .engine_registry import engines
-from .engines.base import SAMPLER
+from .engines.base import SAMPLER, Engine
 from .posterior import Posterior
 from .prior_set import PriorSet
 
@@ -163,12 +163,12 @@ def calibrate(engine: str, model, priors: dict, geometry: Geometry, replicates: 
               engine_options: dict | None = None, noise_dop: float = 0.01, noise_brdf: float = 0.05,
               mueller_noise: float | None = None, likelihood_noise_scale: float = 1.0, rank_draws: int = RANK_DRAWS,
               progress: bool = False) -> Calibration:
-    """SBC of the sampling ``engine`` (a registry name) for ``model`` with ``priors`` (name -> Prior; the model's
+    """SBC of the sampling ``engine`` (a registry name, or an ``Engine`` instance) for ``model`` with ``priors`` (name -> Prior; the model's
     defaults otherwise) at ``geometry``: ``replicates`` truths drawn from the prior, one data set each, one run each
     with ``engine_options``. ``rng`` draws the truths, the noise and each run's seed."""
     from ..errors import SpacepolError
 
-    sampler = engines.get(engine, kind=SAMPLER)
+    sampler = engine if isinstance(engine, Engine) else engines.get(engine, kind=SAMPLER)
     options = dict(engine_options or {})
     sampler.check_options(options)
     prior_set = PriorSet(model.parameters, priors)
@@ -202,7 +202,7 @@ def calibrate(engine: str, model, priors: dict, geometry: Geometry, replicates: 
         del posterior
         jax.clear_caches()
         if progress:
-            print(f"  SBC {engine} {r + 1}/{replicates} ({time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
+            print(f"  SBC {sampler.label} {r + 1}/{replicates} ({time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
     return Calibration(engine=sampler.label, names=names, truths=np.array(truths), ranks=np.array(ranks),
                        inside={level: np.array(v) for level, v in inside.items()}, rank_draws=rank_draws,
                        refused=refused, seconds=time.perf_counter() - start,

@@ -119,3 +119,26 @@ def test_symmetry_checks_measure_noise_and_catch_a_broken_relation():
     words = reciprocity.symmetry_findings(reciprocity.symmetry_checks(broken), {"pol": 0.01})
     assert any("The data break m13/m31" in w for w in words) and "(reciprocal pairs: 0.0100)" in words[0]
     assert not any("The data break" in w for w in reciprocity.symmetry_findings(checks))
+
+
+def test_mirror_asymmetry_is_noise_on_an_isotropic_set_and_flags_the_pairs_made_anisotropic():
+    """An isotropic set with noise 0.01 in every element: the mirror pairs' chi^2 per degree of freedom is 1 within
+    its Monte-Carlo error (300 pairs x 15: SD ~0.02) and no pair passes the Bonferroni limit (p < 0.001 over all
+    pairs). Control: 10 pairs whose -dphi member gets m13 and m31 shifted by 0.05 (5 sigma: what a slight in-plane
+    anisotropy does to the elements odd in dphi) are flagged, and only they (chi^2 ~ 15 + 2 x 50 against the
+    limit's ~50)."""
+    sigma = 0.01
+    noise = {"pol": sigma, "lin": sigma, "circ": sigma}
+    data = _symmetric_set(sigma)
+    clean = reciprocity.mirror_asymmetry(data, noise)
+    assert len(clean.pairs) == 300 and abs(clean.excess - 1) < 0.1, clean.excess
+    assert clean.flagged.sum() == 0 and "0 pairs (0 rows)" in clean.text
+    shifted = clean.pairs[:10, 1]
+    m11 = data.mueller[0, 0, shifted]
+    data.mueller[0, 2, shifted] += 0.1 * m11
+    data.mueller[2, 0, shifted] += 0.1 * m11
+    anisotropic = reciprocity.mirror_asymmetry(data, noise)
+    assert set(np.flatnonzero(anisotropic.flagged)) == set(range(10)), np.flatnonzero(anisotropic.flagged)
+    assert len(anisotropic.rows) == 20 and anisotropic.excess > clean.excess
+    with pytest.raises(ValueError, match="no noise for the circ group"):
+        reciprocity.mirror_asymmetry(data, {"pol": sigma, "lin": sigma})

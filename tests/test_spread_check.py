@@ -72,3 +72,4 @@ def test_the_laplace_engine_falls_back_to_emcee_and_says_so(tmp_path):
     assert "spread beyond them" in result.summary["laplace_refused"]
     saved = spacepol.Result.load(tmp_path / "run")
     assert saved.summary["diagnostics"]["engine"] == "emcee" and saved.summary["laplace_refused"]
+    assert "Laplace approximation was refused" in (tmp_path / "run" / "report.html").read_text()

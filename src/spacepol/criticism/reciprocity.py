@@ -15,6 +15,8 @@ or alignment error. Germer's PTFE set is reciprocal by construction of his measu
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..infer.measured_noise import RECIPROCITY_SIGNS, mirror_pairs, reciprocal_pairs
@@ -120,6 +122,60 @@ def symmetry_checks(data, tolerance_deg: float = 0.01) -> dict:
                                                       "rms_opposite_sign": _rms((y + s[i] * s[j] * x) / 2)}
         out["equal_angles"] = {"n_rows": int(equal.sum()), "pairs": rows}
     return out
+
+
+@dataclass(frozen=True)
+class MirrorAsymmetry:
+    """Per mirror pair (``pairs``, row indices a, b) the asymmetry chi^2 = sum over the 15 normalised elements of
+    (m(b) - D m(a) D)^2 / (2 sigma^2), sigma the element's measured noise (15 degrees of freedom under isotropy);
+    ``flagged``: the pairs beyond the ``alpha`` quantile, Bonferroni over the pairs (what an isotropic sample at that
+    noise gives by chance in fewer than ``alpha`` of measurements)."""
+
+    pairs: np.ndarray
+    chi2: np.ndarray
+    flagged: np.ndarray
+    alpha: float
+
+    @property
+    def rows(self) -> np.ndarray:
+        """The rows of the flagged pairs, both members, sorted."""
+        return np.unique(self.pairs[self.flagged].ravel())
+
+    @property
+    def excess(self) -> float:
+        """Mean chi^2 per degree of freedom over all pairs: 1 for an isotropic sample at the measured noise."""
+        return float(np.mean(self.chi2) / 15.0) if len(self.chi2) else float("nan")
+
+    @property
+    def text(self) -> str:
+        """The finding in one sentence."""
+        return (f"Mirror asymmetry against the measured noise, no model: {len(self.pairs)} pairs measured at dphi and "
+                f"-dphi, chi^2 per degree of freedom {self.excess:.2f} (1 for an isotropic sample); "
+                f"{int(self.flagged.sum())} pairs ({len(self.rows)} rows) differ beyond what the noise gives by chance "
+                f"(p < {self.alpha:g}, Bonferroni over the pairs): the sample is anisotropic there")
+
+
+def mirror_asymmetry(data, noise: dict, alpha: float = 1e-3, tolerance_deg: float = 0.01) -> MirrorAsymmetry:
+    """The mirror pairs' asymmetry against ``noise`` ({group: the measured noise of the normalised elements},
+    groups of ``observables.mueller.GROUPS``; a group may be given as ``sigma_m_GROUP`` too). Needs the Mueller matrix."""
+    from scipy.stats import chi2 as chi2_distribution
+
+    if data.mueller is None:
+        raise ValueError("mirror_asymmetry needs the Mueller matrix")
+    sigma = np.ones((4, 4))
+    for group, members in GROUPS.items():
+        value = noise.get(group, noise.get(f"sigma_m_{group}"))
+        if value is None:
+            raise ValueError(f"mirror_asymmetry: no noise for the {group} group")
+        for e in members:
+            sigma[int(e[1]) - 1, int(e[2]) - 1] = value
+    pairs = mirror_pairs(data, tolerance_deg)
+    m = data.mueller / np.where(data.mueller[0, 0] > 0, data.mueller[0, 0], np.inf)
+    a, b = pairs.T if len(pairs) else (np.array([], int), np.array([], int))
+    d = m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
+    chi2 = (d**2 / (2 * sigma[..., None] ** 2)).reshape(16, -1)[1:].sum(axis=0)
+    limit = chi2_distribution.isf(alpha / max(len(pairs), 1), 15)
+    return MirrorAsymmetry(pairs=pairs, chi2=chi2, flagged=chi2 > limit, alpha=alpha)
 
 
 def symmetry_findings(symmetry: dict, measured: dict | None = None) -> list[str]:

@@ -100,6 +100,8 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
         verdict = (f"Converged ({quality.engine}): R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
                    "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting "
                    "the intervals.")
+    if s.get("laplace_refused"):
+        verdict = f"The Laplace approximation was refused ({s['laplace_refused']}); emcee sampled instead. " + verdict
     if s.get("log_evidence"):
         verdict += f" Log evidence ln Z = {s['log_evidence']['value']:.2f} +- {s['log_evidence']['error']:.2f}."
     if s["sampler"].get("missed_mode"):

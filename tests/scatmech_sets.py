@@ -122,3 +122,40 @@ def ptfe_like_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float
         mueller[:, :, j] = M
     return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed),
                     f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)")
+
+
+# PTFE-like with light scattered once by pores: air spheres (radius 0.15 um, size parameter 2.0) in the polymer,
+# their Mie phase matrix (SCATMECH's SphericalScatterer_Phase_Function; outside the Code-Whitney family and the
+# spline of phase_matrix), refraction through the polymer's interface, and linear depolarization along the legs
+PTFE_PORES = {"n": 1.35, "sigma": 0.3, "ks": 0.15, "rho_s": 0.5, "radius_um": 0.15, "depoll": 0.2}
+
+
+def ptfe_pores_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float = 0.02, seed: int = 0,
+                   truth: dict = PTFE_PORES) -> Dataset:
+    """Facets (weight ks) + SCATMECH's subsurface multiple scattering + (``volume``) first-order scattering by air
+    pores in the polymer (Mie, ``First_Diffuse_BRDF_Model`` with ``SphericalScatterer_Phase_Function``), at
+    ``ptfe_like_geometry``; noise as ``ptfe_like_set``."""
+    from pySCATMECH.brdf import BRDF_Model
+
+    m = truth
+    substrate = f"({m['n']},0)"
+    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
+    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                                        "reflectance": "Table_Reflectance", "reflectance.table": m["rho_s"]})
+    once = BRDF_Model("First_Diffuse_BRDF_Model", {
+        "lambda": 0.633, "substrate": substrate, "type": 0, "depoll": m["depoll"], "depolc": 0.0,
+        "phase_function": "SphericalScatterer_Phase_Function", "phase_function.scatterer": "MieScatterer",
+        "phase_function.scatterer.lambda": 0.633, "phase_function.scatterer.medium": substrate,
+        "phase_function.scatterer.radius": m["radius_um"], "phase_function.scatterer.sphere": "(1,0)",
+        "phase_function.volume_density": 0.01})
+    g = ptfe_like_geometry()
+    mueller = np.empty((4, 4, g.size))
+    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
+        args = np.radians([ti, tr, 180.0 - dphi])
+        M = m["ks"] * np.array(facets.MuellerBRDF(*args)) + np.array(under.MuellerBRDF(*args))
+        if volume:
+            M = M + np.array(once.MuellerBRDF(*args))
+        mueller[:, :, j] = M
+    return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed),
+                    f"SCATMECH PTFE-like render with pores ({'with' if volume else 'without'} volume scattering)")

@@ -173,6 +173,7 @@ def _inversion(posterior: Posterior, result: EngineResult, idata, loo_result: di
         # the whole model: what contrast rebuilds
         "spec": spec_of(posterior.likelihood.model, posterior.likelihood.data.wavelength_um),
         "parameters": quantiles(result),
+        "engine": diagnostics["engine"],  # what drew the posterior (emcee where the Laplace engine was refused)
         "diagnostics": diagnostics,
         "fit": fit_statistics(posterior, result, loo_result),
         "seconds": time.perf_counter() - start,

@@ -216,6 +216,13 @@ def top_findings(records: list[dict]) -> list[str]:
     return out
 
 
+def posterior_words(record: dict) -> str:
+    """How the posterior was drawn, and NOT converged where an emcee chain stopped at its cap above R-hat 1.01."""
+    if record["engine"] != "emcee" or record["rhat_max"] is None or record["rhat_max"] <= 1.01:
+        return record["engine"]
+    return f"emcee, NOT converged (R-hat {record['rhat_max']:.2f}): its ELPD-LOO is not to be trusted"
+
+
 def write_report(out: Path, args, data, noise, aniso, masked: int, records, table, misfit) -> None:
     lines = [f"# PTFE under competing models ({', '.join(sorted(noise))} um jointly)", "",
              f"Re-made by `python studies/ptfe_models.py {' '.join(sys.argv[1:])}`; {len(data)} geometries"
@@ -236,7 +243,7 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
     for t in table:
         r = by_model[t["model"]]
         lines.append(f"| {t['model']} | {r['free_parameters']} | {t['elpd_loo']:.1f} +- {t['elpd_loo_se']:.1f} | "
-                     f"{t['delta_elpd']:.1f} +- {t['delta_elpd_se']:.1f} | {r['engine']} | "
+                     f"{t['delta_elpd']:.1f} +- {t['delta_elpd_se']:.1f} | {posterior_words(r)} | "
                      + ", ".join(f"{g}@{w} {v:.2f}" for w, groups in r["misfit_ratio"].items() for g, v in groups.items())
                      + " | "
                      + ", ".join(f"{i['name']} {i['median']:.3f} [{i['q05']:.3f}, {i['q95']:.3f}]" for i in r["indices"])

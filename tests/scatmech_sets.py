@@ -94,6 +94,30 @@ def ptfe_like_geometry(size: int = 280) -> Geometry:
     return Geometry(data.theta_i[rows], data.theta_r[rows], data.dphi[rows])
 
 
+def _surface_and_body(m: dict, substrate: str):
+    """SCATMECH's Beckmann facets and its subsurface multiple scattering (albedo rho_s) of ``m`` under ``substrate``."""
+    from pySCATMECH.brdf import BRDF_Model
+
+    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
+    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
+                                                        "reflectance": "Table_Reflectance", "reflectance.table": m["rho_s"]})
+    return facets, under
+
+
+def _ptfe_like_render(m: dict, facets, under, once, noise_m, noise_brdf, seed, source) -> Dataset:
+    """ks x facets + subsurface (+ ``once``, where not None) at ``ptfe_like_geometry``, measured with that noise."""
+    g = ptfe_like_geometry()
+    mueller = np.empty((4, 4, g.size))
+    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
+        args = np.radians([ti, tr, 180.0 - dphi])
+        M = m["ks"] * np.array(facets.MuellerBRDF(*args)) + np.array(under.MuellerBRDF(*args))
+        if once is not None:
+            M = M + np.array(once.MuellerBRDF(*args))
+        mueller[:, :, j] = M
+    return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed), source)
+
+
 def ptfe_like_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float = 0.02, seed: int = 0,
                   truth: dict = PTFE_LIKE) -> Dataset:
     """Facets (weight ks) + SCATMECH's subsurface multiple scattering + (``volume``) first-order volume
@@ -103,25 +127,14 @@ def ptfe_like_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: float
 
     m = truth
     substrate = f"({m['n']},{m['k']})"
-    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
-                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
-    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
-                                                        "reflectance": "Table_Reflectance", "reflectance.table": m["rho_s"]})
+    facets, under = _surface_and_body(m, substrate)
     once = BRDF_Model("First_Diffuse_BRDF_Model", {
         "lambda": 0.633, "substrate": substrate, "type": 0, "phase_function": "CodeWhitney_Phase_Function",
         "phase_function.phase_function": "Henyey_Greenstein_Phase_Function", "phase_function.phase_function.g": m["g_vol"],
         "phase_function.plmax": m["pl_vol"], "phase_function.pcmax": m["pc_vol"], "phase_function.s": m["s_vol"],
         "phase_function.log_absorption": _LOG_ABSORPTION, "phase_function.log_scattering": 0})
-    g = ptfe_like_geometry()
-    mueller = np.empty((4, 4, g.size))
-    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
-        args = np.radians([ti, tr, 180.0 - dphi])
-        M = m["ks"] * np.array(facets.MuellerBRDF(*args)) + np.array(under.MuellerBRDF(*args))
-        if volume:
-            M = M + np.array(once.MuellerBRDF(*args))
-        mueller[:, :, j] = M
-    return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed),
-                    f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)")
+    return _ptfe_like_render(m, facets, under, once if volume else None, noise_m, noise_brdf, seed,
+                             f"SCATMECH PTFE-like render ({'with' if volume else 'without'} volume scattering)")
 
 
 # PTFE-like with light scattered once by pores: air spheres (radius 0.15 um, size parameter 2.0) in the polymer,
@@ -139,23 +152,12 @@ def ptfe_pores_set(volume: bool = True, noise_m: float = 0.012, noise_brdf: floa
 
     m = truth
     substrate = f"({m['n']},0)"
-    facets = BRDF_Model("Facet_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
-                                            "sdf": "Gaussian_Slope_Distribution_Function", "sdf.s": np.sqrt(2) * m["sigma"]})
-    under = BRDF_Model("Diffuse_Subsurface_BRDF_Model", {"lambda": 0.633, "substrate": substrate, "type": 0,
-                                                        "reflectance": "Table_Reflectance", "reflectance.table": m["rho_s"]})
+    facets, under = _surface_and_body(m, substrate)
     once = BRDF_Model("First_Diffuse_BRDF_Model", {
         "lambda": 0.633, "substrate": substrate, "type": 0, "depoll": m["depoll"], "depolc": 0.0,
         "phase_function": "SphericalScatterer_Phase_Function", "phase_function.scatterer": "MieScatterer",
         "phase_function.scatterer.lambda": 0.633, "phase_function.scatterer.medium": substrate,
         "phase_function.scatterer.radius": m["radius_um"], "phase_function.scatterer.sphere": "(1,0)",
         "phase_function.volume_density": 0.01})
-    g = ptfe_like_geometry()
-    mueller = np.empty((4, 4, g.size))
-    for j, (ti, tr, dphi) in enumerate(zip(g.theta_i, g.theta_r, g.dphi)):
-        args = np.radians([ti, tr, 180.0 - dphi])
-        M = m["ks"] * np.array(facets.MuellerBRDF(*args)) + np.array(under.MuellerBRDF(*args))
-        if volume:
-            M = M + np.array(once.MuellerBRDF(*args))
-        mueller[:, :, j] = M
-    return measured(g, mueller, noise_m, noise_brdf, np.random.default_rng(seed),
-                    f"SCATMECH PTFE-like render with pores ({'with' if volume else 'without'} volume scattering)")
+    return _ptfe_like_render(m, facets, under, once if volume else None, noise_m, noise_brdf, seed,
+                             f"SCATMECH PTFE-like render with pores ({'with' if volume else 'without'} volume scattering)")

@@ -73,3 +73,24 @@ def test_rounds_from_the_paper_reach_volume_on_spacepols_own_render():
     assert "volume" in result["final_model"].split("+"), result["final_model"]
     assert final["fit"]["chi2_red"] < 1.5
     assert abs(final["parameters"]["n"]["median"] - truth["n"]) < 0.02, final["parameters"]["n"]
+
+
+@pytest.mark.slow
+def test_a_volume_term_with_a_mie_phase_matrix_is_added_and_its_control_gets_none():
+    """SCATMECH render of PTFE-like pores (``ptfe_pores_set``: Mie scattering by air spheres of radius 0.15 um in the
+    polymer, linear depolarization along the legs; a phase matrix outside the Code-Whitney family and the spline of
+    phase_matrix) under facets and subsurface multiple scattering. From specular+smith+subsurface, diagnose adds a
+    volume term (phase_matrix or volume) by a decisive ELPD-LOO gain; the control without pores gets none."""
+    from scatmech_sets import ptfe_pores_set
+
+    candidates = ["volume", "volume_rayleigh", "phase_matrix", "lambertian", "depolarization", "polarized_diffuse"]
+    base = Model.from_string("specular+smith+subsurface")
+    for hidden in (True, False):
+        result = diagnose_rounds(ptfe_pores_set(hidden, seed=7), base, np.random.default_rng(0), rounds=1,
+                                 candidates=candidates, progress=False)
+        if hidden:
+            assert result["verdict"] in ("phase_matrix", "volume"), result["verdict"]
+            lead = result["ranking"][0]
+            assert lead["delta_elpd"] > 10 * lead["delta_elpd_se"], lead
+        else:
+            assert result["verdict"] not in VOLUME | {"phase_matrix"}, result["verdict"]

@@ -26,17 +26,10 @@ from spacepol.infer.engine_registry import SAMPLER, engines  # noqa: E402
 from spacepol.infer.inversion import invert  # noqa: E402
 from spacepol.infer.laplace import laplace_importance  # noqa: E402
 from spacepol.infer.optimum import find_optimum  # noqa: E402
-from spacepol.infer.spread_check import spread_check  # noqa: E402
+from spacepol.infer.spread_check import spread_check, weighted_sd  # noqa: E402
 
 
 REFERENCE_TAUS = 250  # the reference chain: 5x emcee's default length, so its own SDs carry ~1/sqrt(5) the error
-
-
-def weighted_sd(sample) -> np.ndarray:
-    w = np.exp(sample.log_weights - np.max(sample.log_weights))
-    w /= w.sum()
-    mean = w @ sample.theta
-    return np.sqrt(w @ (sample.theta - mean) ** 2)
 
 
 def main():
@@ -61,7 +54,8 @@ def main():
             for seed in args.seeds:
                 sample = laplace_importance(post, centre, np.random.default_rng(seed))
                 trusted = sample is not None and sample.reliable
-                is_ratio = weighted_sd(sample)[:2] / exact[:2] if sample is not None else [np.nan, np.nan]
+                is_ratio = (weighted_sd(sample.theta, sample.log_weights)[:2] / exact[:2] if sample is not None
+                            else [np.nan, np.nan])
                 growth = (spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0]).ratios[:2]
                           if trusted else [np.nan, np.nan])
                 start = time.perf_counter()

@@ -62,6 +62,7 @@ from .diagnostics import PARETO_K_LIMIT, loo_fields
 from .posterior import Posterior
 from .psis import logsumexp_rows, psis_log_weights
 from .sampling_space import SamplingSpace
+from .spread_check import weighted_sd
 
 MIN_EFFECTIVE_DRAWS = 400  # as emcee's ESS target
 PROPOSAL_DF = 5.0
@@ -281,10 +282,7 @@ def _width_ratio(space: SamplingSpace, sample: ImportanceSample, laplace_sd: np.
     keep = np.all(np.isfinite(z), axis=1) & np.isfinite(sample.log_weights)
     if not keep.any():
         return 0.0
-    w = np.exp(sample.log_weights[keep] - logsumexp(sample.log_weights[keep]))
-    mean = w @ z[keep]
-    sd = np.sqrt(w @ (z[keep] - mean) ** 2)
-    return float(np.min(sd / laplace_sd))
+    return float(np.min(weighted_sd(z[keep], sample.log_weights[keep]) / laplace_sd))
 
 
 def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df) -> ImportanceSample | None:

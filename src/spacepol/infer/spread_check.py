@@ -69,7 +69,8 @@ class SpreadCheck:
                 "steps": self.steps, "walkers": self.walkers, "limit": MAX_SD_GROWTH}
 
 
-def _weighted_sd(theta: np.ndarray, log_weights: np.ndarray) -> np.ndarray:
+def weighted_sd(theta: np.ndarray, log_weights: np.ndarray) -> np.ndarray:
+    """Per column, the SD of draws ``theta`` (S, D) under log weights (S,), any normalisation; -inf weighs 0."""
     keep = np.isfinite(log_weights)
     w = np.exp(log_weights[keep] - np.max(log_weights[keep]))
     w /= w.sum()
@@ -103,7 +104,7 @@ def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS
     sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
     sampler.run_mcmc(_starts(space, sample, rng, walkers), steps, progress=False)
     chain = space.to_theta(sampler.get_chain(discard=steps // 2))  # (steps/2, walkers, D)
-    draws_sd = _weighted_sd(sample.theta, sample.log_weights)
+    draws_sd = weighted_sd(sample.theta, sample.log_weights)
     ratios = chain.reshape(-1, ndim).std(axis=0) / draws_sd
     # batch means: the SD of each of BATCHES consecutive stretches of the kept steps, their scatter over sqrt(BATCHES)
     batches = np.array([b.reshape(-1, ndim).std(axis=0) for b in np.array_split(chain, BATCHES)]) / draws_sd

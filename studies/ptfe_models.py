@@ -32,6 +32,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from spacepol.criticism.reciprocity import mirror_asymmetry  # noqa: E402
+from spacepol.errors import SpacepolError  # noqa: E402
 from spacepol.infer.indices import index_findings  # noqa: E402
 from spacepol.infer.inference_data import median_fit  # noqa: E402
 from spacepol.infer.inversion import invert, laplace_fit  # noqa: E402
@@ -264,6 +265,12 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="reports/ptfe_models")
     args = parser.parse_args(argv)
+    try:  # every model named, before any work
+        for spec in args.models.split(","):
+            Model.from_string(spec)
+    except SpacepolError as error:
+        print(f"ptfe_models: --models: {error}", file=sys.stderr)
+        return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     data = load(args.wavelength_um)

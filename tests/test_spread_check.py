@@ -73,3 +73,7 @@ def test_the_laplace_engine_falls_back_to_emcee_and_says_so(tmp_path):
     saved = spacepol.Result.load(tmp_path / "run")
     assert saved.summary["engine"] == "emcee" and saved.summary["laplace_refused"]
     assert "Laplace approximation was refused" in (tmp_path / "run" / "report.html").read_text()
+    # the fallback keeps its chain in the run folder, as emcee does: the same call again reads it instead of sampling
+    assert (tmp_path / "run" / "chain.h5").exists()
+    again = spacepol.invert(band_data(METAL, brdf_noise=1.0), "paper", engine="laplace", seed=1, out=tmp_path / "run")
+    np.testing.assert_array_equal(again.draws.flat_samples(), result.draws.flat_samples())

@@ -49,7 +49,7 @@ class Laplace(Engine):
     it (Pareto k, effective draws, width, the walkers' spread), emcee samples instead and the Result says so
     (``summary["diagnostics"]["engine"]`` names what ran, ``summary["laplace_refused"]`` why)."""
 
-    name, kind = "laplace", SAMPLER
+    name, kind, resumable = "laplace", SAMPLER, True  # its emcee fallback keeps its chain, so an interrupted run continues
     description = "Laplace approximation at the optimum corrected by importance sampling; emcee where it cannot be trusted"
 
     def run(self, posterior, rng, draws: int = 2000, progress: bool = False):
@@ -73,6 +73,12 @@ class Laplace(Engine):
         result = invert(posterior, seed=seed, progress=progress, centre=centre, backend_path=chain)
         result.summary["laplace_refused"] = refusal
         return result
+
+    def check_chain(self, chain, posterior, seed: int, **_) -> None:
+        """A chain its emcee fallback left in ``chain`` must belong to this run (before any work)."""
+        from ..inversion import check_resumable
+
+        check_resumable(chain, posterior, None, seed)
 
 
 class Nuts(Engine):

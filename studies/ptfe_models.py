@@ -217,6 +217,18 @@ def top_findings(records: list[dict]) -> list[str]:
     return out
 
 
+def misfit_words(misfit: dict) -> str:
+    """Where the best model's misfit sits, from ``misfit_map``'s record: the elements whose RMS residual exceeds twice
+    the measured noise in most geometry bins, at each wavelength."""
+    parts = []
+    for label, grid in misfit["rms"].items():
+        grid = np.array(grid, float)
+        worst = [(e, float(np.nanmedian(row))) for e, row in zip(misfit["elements"], grid) if np.nanmedian(row) > 2]
+        parts.append(f"{label} um: " + (", ".join(f"{e} {v:.1f}x" for e, v in worst) or "no element above 2x"))
+    return ("Where the best model misses (median over the theta_i x theta_r bins of misfit.png of the RMS residual / "
+            "measured noise, elements above 2x): " + "; ".join(parts))
+
+
 def posterior_words(record: dict) -> str:
     """How the posterior was drawn, and NOT converged where an emcee chain stopped at its cap above R-hat 1.01."""
     if record["engine"] != "emcee" or record["rhat_max"] is None or record["rhat_max"] <= 1.01:
@@ -229,6 +241,8 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
              f"Re-made by `python studies/ptfe_models.py {' '.join(sys.argv[1:])}`; {len(data)} geometries"
              + (f" after {masked} anisotropic rows left out" if masked else "") + ".", "", "## Findings", ""]
     lines += [f"- {f}" for f in (top_findings(records) if records else ["no model fitted yet"])]
+    if misfit:
+        lines.append(f"- {misfit_words(misfit)}")
     lines += ["", "## The noise the data measure (reciprocal pairs)", "", "| wavelength | pol | lin | circ |", "|---|---|---|---|"]
     lines += [f"| {w} | " + " | ".join(f"{v.get(g, float('nan')):.4f}" for g in ("pol", "lin", "circ")) + " |"
               for w, v in noise.items()]

@@ -9,7 +9,6 @@ import sys
 
 import numpy as np
 
-from ...errors import SpacepolError
 from .base import OPTIMIZER, SAMPLER, Engine
 from .nlopt_engine import NLOPT_ALGORITHMS, check_algorithm
 

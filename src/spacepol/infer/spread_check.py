@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import emcee
 import numpy as np
 
-from .engines.snooker import DESnookerMove
+from .engines.emcee_sampler import default_walkers, ridge_moves
 from .sampling_space import SamplingSpace
 
 # walker steps; the SDs compared are those of the second half. On a metal's n-k band (DOP with a 100 %-noise BRDF,
@@ -94,12 +94,11 @@ def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS
     """Run emcee's ensemble from ``sample`` (an ``laplace.ImportanceSample`` of ``posterior``) and compare SDs."""
     space = SamplingSpace(posterior.priors)
     ndim = posterior.ndim
-    walkers = walkers or max(MIN_WALKERS, 2 * ((4 * ndim + 1) // 2))
+    walkers = walkers or max(MIN_WALKERS, default_walkers(ndim))
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.add(walkers // 2)  # emcee evaluates half the ensemble at a time
     log_prob = space.log_prob(posterior)
-    sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True,
-                                    moves=[(emcee.moves.DEMove(), 0.8), (DESnookerMove(), 0.2)])
+    sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=ridge_moves())
     sampler.log_prob_fn = log_prob  # called directly: emcee's wrapper prints every walker on an exception
     sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
     sampler.run_mcmc(_starts(space, sample, rng, walkers), steps, progress=False)

@@ -86,8 +86,9 @@ def model_for(data, spec: str):
     return SpectralModel(model, lams) if len(lams) > 1 else model
 
 
-def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict) -> tuple[dict, object]:
-    """(record, Result) of ``spec`` on ``data``: maximum, posterior, ELPD-LOO, noise ratios, indices."""
+def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict) -> tuple[dict, object, dict]:
+    """(record, Result, standardised residuals) of ``spec`` on ``data``: maximum, posterior, ELPD-LOO, misfit per
+    group, indices."""
     start = time.perf_counter()
     post = Posterior.build(data, model_for(data, spec))
     best, centre = find_optimum_profiled(post, np.random.default_rng(seed), evaluations=3000)
@@ -99,18 +100,19 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict) ->
         inv = invert(post, seed=seed, progress=False, centre=centre, max_steps=max_steps, max_pointwise_draws=2000)
     s = inv.summary
     parameters = s["parameters"] | s.get("derived", {})
+    z = standardised(inv, noise)
     record = {
         "model": spec, "free_parameters": post.ndim, "max_log_posterior": best, "engine": s["diagnostics"]["engine"],
         "laplace_refused": "" if method != "laplace" else refusal, "rhat_max": s["diagnostics"]["rhat_max"],
         "elpd_loo": s["fit"]["elpd_loo"], "elpd_loo_se": s["fit"]["elpd_loo_se"],
         "inferred_noise": {k: v["median"] for k, v in s["parameters"].items() if k.startswith("sigma_m_")},
-        "misfit_ratio": group_ratios(inv, noise),
+        "misfit_ratio": group_ratios(z, data),
         "indices": [{"name": f.name, "median": f.median, "q05": f.q05, "q95": f.q95, "determined": f.determined,
                      "physical": f.physical, "text": f.text} for f in index_findings(parameters, PTFE_BAND)],
         "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s["identifiability"]["at_bound"]],
         "seconds": time.perf_counter() - start,
     }
-    return record, inv
+    return record, inv, z
 
 
 def ranking(records: list[dict], pointwise: dict) -> list[dict]:
@@ -138,9 +140,9 @@ def standardised(inv, noise: dict) -> dict:
     return out
 
 
-def group_ratios(inv, noise: dict) -> dict:
-    """{wavelength: {group: RMS of the standardised residuals}}: 1 where the model leaves the measured noise."""
-    z, data = standardised(inv, noise), inv.posterior.likelihood.data
+def group_ratios(z: dict, data) -> dict:
+    """{wavelength: {group: RMS of the standardised residuals ``z`` of the rows of ``data``}}: 1 where the model
+    leaves the measured noise."""
     out = {}
     for w in np.unique(data.wavelength_um):
         at = data.wavelength_um == w
@@ -150,11 +152,11 @@ def group_ratios(inv, noise: dict) -> dict:
     return out
 
 
-def misfit_map(inv, noise: dict):
-    """Per wavelength, RMS of (data - posterior-median prediction) / the measured noise of each element's group, in
-    bins of theta_i (rows of the data) x theta_r (4 bins): where the misfit sits. Element x geometry."""
+def misfit_map(inv, standard: dict):
+    """Per wavelength, RMS of the standardised residuals (``standardised``: data - posterior-median prediction over
+    the measured noise of each element's group), in bins of theta_i (rows of the data) x theta_r (4 bins): where the
+    misfit sits. Element x geometry."""
     lik, data = inv.posterior.likelihood, inv.posterior.likelihood.data
-    standard = standardised(inv, noise)
     elements = list(standard)
     incidences = np.unique(np.round(np.abs(data.theta_i)))
     r_edges = np.array([0, 20, 40, 60, 90])
@@ -300,12 +302,12 @@ def main(argv=None) -> int:
           f"load {os.getloadavg()[0]:.2f}", flush=True)
     records, pointwise, misfit = [], {}, None
     for spec in args.models.split(","):
-        record, inv = fit(data, spec, args.seed, args.posterior, args.max_steps, noise)
+        record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise)
         records.append(record)
         pointwise[spec] = np.asarray(inv.loo["pointwise"])
         table = ranking(records, pointwise)
         if table[0]["model"] == spec:
-            fig, misfit = misfit_map(inv, noise)
+            fig, misfit = misfit_map(inv, standard)
             save_figure(fig, out / "misfit.png")
         write_json(out / "study.json", {"records": records, "ranking": table, "measured_noise": noise,
                                         "anisotropy": {w: {"pairs": len(a.pairs), "flagged": int(a.flagged.sum()),

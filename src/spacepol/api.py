@@ -149,7 +149,8 @@ def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0
 
     ``engine``: a sampler of the engine registry: ``emcee`` (affine-invariant ensemble, the default), ``laplace`` (a
     Laplace approximation at the optimum corrected by importance sampling; emcee where its checks refuse it, and the
-    summary says so: ``diagnostics.engine`` and ``laplace_refused``), ``nuts``, an entry point of group ``spacepol.engines`` or a file ``path/to/engine.py:Name``.
+    summary says so: ``engine`` and ``laplace_refused``), ``nuts``, an entry point of group ``spacepol.engines`` or a
+    file ``path/to/engine.py:Name``.
     ``walkers`` and ``steps`` are emcee's (``walkers``, ``max_steps``); ``engine_options`` go to the engine's ``run``.
     With ``out`` the run is kept in that folder as ``invert-mcmc run`` keeps it: for a resumable engine (emcee) the
     chain (an interrupted call continues with the same arguments; ``restart`` starts afresh and keeps the old chain
@@ -307,9 +308,9 @@ def calibrate(model, priors: dict, geometry, *, engine="emcee", replicates: int 
               engine_options: dict | None = None, noise_dop: float = 0.01, noise_brdf: float = 0.05,
               mueller_noise: float | None = None, likelihood_noise_scale: float = 1.0, progress: bool = False):
     """Simulation-based calibration of a sampling ``engine`` (a registry name or an ``Engine``;
-    ``infer.calibration``): ``replicates`` truths from
-    ``priors`` ({name: Prior}; the model's defaults for the rest), data simulated at ``geometry`` (a Geometry, a
-    Dataset or a file of geometries) with Gaussian noise of known size, one run each. Returns a ``Calibration``:
+    ``infer.calibration``): ``replicates`` truths from ``priors`` ({name: Prior}; the model's defaults for the rest),
+    data simulated at ``geometry`` (a Geometry, a Dataset or a file of geometries) with Gaussian noise of known size,
+    one run each. Returns a ``Calibration``:
     coverage of the 50 % and 90 % intervals, rank histograms and their figure, ``calibrated``, ``failures``."""
     from .infer.calibration import calibrate as run_sbc
     from .io.measurements import read_measurements

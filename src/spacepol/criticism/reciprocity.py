@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..infer.measured_noise import RECIPROCITY_SIGNS, mirror_pairs, reciprocal_pairs
-from ..observables.mueller import GROUPS
+from ..observables.mueller import GROUPS, index
 from ..physics.geometry import Geometry
 
 Q = np.diag(RECIPROCITY_SIGNS)
@@ -97,13 +97,13 @@ def symmetry_checks(data, tolerance_deg: float = 0.01) -> dict:
     sign obeys at the noise level is structure that no reciprocal, mirror-symmetric model in this basis can fit."""
     if data.mueller is None:
         return {}
-    m = data.mueller / np.where(data.mueller[0, 0] > 0, data.mueller[0, 0], np.inf)
+    m = _normalised(data)
     names = [f"m{i + 1}{j + 1}" for i in range(4) for j in range(4)][1:]
     out: dict = {}
     pairs = mirror_pairs(data, tolerance_deg)
     if len(pairs):
         a, b = pairs.T
-        symmetric = m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
+        symmetric = _mirror_differences(m, pairs)
         plain = m[..., b] - m[..., a]
         elements = {}
         for name in names:
@@ -168,11 +168,9 @@ def mirror_asymmetry(data, noise: dict, alpha: float = 1e-3, tolerance_deg: floa
         if value is None:
             raise ValueError(f"mirror_asymmetry: no noise for the {group} group")
         for e in members:
-            sigma[int(e[1]) - 1, int(e[2]) - 1] = value
+            sigma[index(e)] = value
     pairs = mirror_pairs(data, tolerance_deg)
-    m = data.mueller / np.where(data.mueller[0, 0] > 0, data.mueller[0, 0], np.inf)
-    a, b = pairs.T if len(pairs) else (np.array([], int), np.array([], int))
-    d = m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
+    d = _mirror_differences(_normalised(data), pairs)
     chi2 = (d**2 / (2 * sigma[..., None] ** 2)).reshape(16, -1)[1:].sum(axis=0)
     limit = chi2_distribution.isf(alpha / max(len(pairs), 1), 15)
     return MirrorAsymmetry(pairs=pairs, chi2=chi2, flagged=chi2 > limit, alpha=alpha)
@@ -220,6 +218,17 @@ def symmetry_findings(symmetry: dict, measured: dict | None = None) -> list[str]
                        "difference of basis on the instrument's out-of-plane rows, and it stays in the residuals of every "
                        "model here.")
     return out
+
+
+def _normalised(data) -> np.ndarray:
+    """The measured Mueller matrices over their M_11 (4, 4, N); a row without a positive M_11 gives zeros."""
+    return data.mueller / np.where(data.mueller[0, 0] > 0, data.mueller[0, 0], np.inf)
+
+
+def _mirror_differences(m: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """m(b) - D m(a) D over mirror ``pairs`` (a, b) of normalised matrices ``m``: zero for an isotropic sample."""
+    a, b = (pairs.T if len(pairs) else (np.array([], int), np.array([], int)))
+    return m[..., b] - np.einsum("ij,jkn,kl->iln", MIRROR, m[..., a], MIRROR)
 
 
 def _rms(x) -> float:

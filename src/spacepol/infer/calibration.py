@@ -163,8 +163,8 @@ def calibrate(engine: str, model, priors: dict, geometry: Geometry, replicates: 
               engine_options: dict | None = None, noise_dop: float = 0.01, noise_brdf: float = 0.05,
               mueller_noise: float | None = None, likelihood_noise_scale: float = 1.0, rank_draws: int = RANK_DRAWS,
               progress: bool = False) -> Calibration:
-    """SBC of the sampling ``engine`` (a registry name, or an ``Engine`` instance) for ``model`` with ``priors`` (name -> Prior; the model's
-    defaults otherwise) at ``geometry``: ``replicates`` truths drawn from the prior, one data set each, one run each
+    """SBC of the sampling ``engine`` (a registry name, or an ``Engine`` instance) for ``model`` with ``priors``
+    (name -> Prior; the model's defaults otherwise) at ``geometry``: ``replicates`` truths drawn from the prior, one data set each, one run each
     with ``engine_options``. ``rng`` draws the truths, the noise and each run's seed."""
     from ..errors import SpacepolError
 

@@ -181,11 +181,13 @@ def stokes_rows(s0, s1, basis):
     return [s0, s1 * basis[1, 1], s1 * basis[1, 2], 0.0]
 
 
-# The internal hemispherical reflectance is a cosine-weighted average over internal angles; quadrature on
-# SCATMECH's grid (0 to 90 deg in 0.2 deg steps, Diffuse_Subsurface_BRDF_Model), so the two agree to
-# rounding. The trapezoid rule on it errs by ~1e-5 of the value (the kink at the critical angle).
-_INTERNAL_ANGLES = np.linspace(0.0, 0.5 * np.pi, 451)
-_INTERNAL_WEIGHTS = np.sin(2.0 * _INTERNAL_ANGLES)
+# The internal hemispherical reflectance is a cosine-weighted average over internal angles. Beyond the critical
+# angle theta_c the reflectance is 1 (that share is cos^2 theta_c); below it, it rises to 1 as sqrt(theta_c - theta),
+# and a fixed grid of angles (SCATMECH's 0.2 deg steps) turns that rise into a kink in n each time theta_c crosses a
+# node: a posterior with cusps no optimizer or Hessian can work on. Gauss-Legendre in t, theta = theta_c (1 - t^2),
+# makes the rise smooth in t and the average a smooth function of n (Walton's closed form, checked in the tests).
+_T_NODES, _T_WEIGHTS = np.polynomial.legendre.leggauss(64)
+_T_NODES, _T_WEIGHTS = 0.5 * (_T_NODES + 1.0), 0.5 * _T_WEIGHTS  # on [0, 1]
 
 
 def internal_reflectance(n, cos_theta):
@@ -198,7 +200,11 @@ def internal_reflectance(n, cos_theta):
 
 def hemispherical_internal_reflectance(n):
     """The share of diffuse light inside a transparent medium of index n that its surface reflects back
-    in: the cos(theta) sin(theta) d(theta) weighted average of ``internal_reflectance``. Shape of ``n``."""
+    in: the cos(theta) sin(theta) d(theta) weighted average of ``internal_reflectance``, a smooth function of n.
+    Shape of ``n``."""
     n = jnp.asarray(n, float)[..., None]
-    r = internal_reflectance(n, np.cos(_INTERNAL_ANGLES))
-    return jnp.sum(r * _INTERNAL_WEIGHTS, axis=-1) / np.sum(_INTERNAL_WEIGHTS)
+    # theta_c = 90 deg where n <= 1 (no total internal reflection); kept off arcsin's infinite slope at 1
+    theta_c = jnp.arcsin(jnp.minimum(1.0 / n, 1.0 - 1e-12))
+    theta = theta_c * (1.0 - _T_NODES**2)
+    below = internal_reflectance(n, jnp.cos(theta)) * jnp.sin(2.0 * theta) * 2.0 * theta_c * _T_NODES
+    return jnp.sum(below * _T_WEIGHTS, axis=-1) + jnp.cos(theta_c[..., 0]) ** 2

@@ -3,12 +3,14 @@ which model reaches the noise the measurement shows itself, and what each says a
 
     python studies/ptfe_models.py [--wavelength-um all] [--in-plane] [--mask-anisotropic]
                                   [--models paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix]
-                                  [--posterior laplace|emcee] [--max-steps 4000] [--seed 0] [--out reports/ptfe_models]
+                                  [--posterior laplace|emcee] [--max-steps 4000] [--search-every 1] [--seed 0]
+                                  [--out reports/ptfe_models]
 
 1. The noise the data measure themselves, per wavelength and Mueller element group (reciprocal pairs).
 2. The sample's anisotropy from the data alone: per mirror pair (dphi, -dphi) the asymmetry chi^2 against that noise
    (``reciprocity.mirror_asymmetry``); with ``--mask-anisotropic`` the rows of pairs beyond the noise are left out.
-3. Per model: the posterior maximum (``find_optimum_profiled``), then diagnose's posterior (Laplace-IS where its
+3. Per model: the posterior maximum (``find_optimum_profiled``; on every n-th row, then polished on all, with
+   ``--search-every``), then diagnose's posterior (Laplace-IS where its
    checks trust it, else emcee up to ``--max-steps``), ELPD-LOO, the inferred noise against the measured one per
    group, and every index-like parameter told honestly (``infer.indices``: determined where its 90 % interval is
    narrower than 0.3; physical for porous PTFE inside [1.15, 1.45]).
@@ -36,7 +38,7 @@ from spacepol.errors import SpacepolError  # noqa: E402
 from spacepol.infer.indices import index_findings  # noqa: E402
 from spacepol.infer.inference_data import median_fit  # noqa: E402
 from spacepol.infer.inversion import invert, laplace_fit  # noqa: E402
-from spacepol.infer.optimum import find_optimum_profiled  # noqa: E402
+from spacepol.infer.optimum import find_optimum_on_every  # noqa: E402
 from spacepol.infer.posterior import Posterior  # noqa: E402
 from spacepol.io import read_measurements  # noqa: E402
 from spacepol.io.atomic import save_figure, write_json, write_text  # noqa: E402
@@ -86,12 +88,14 @@ def model_for(data, spec: str):
     return SpectralModel(model, lams) if len(lams) > 1 else model
 
 
-def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict) -> tuple[dict, object, dict]:
+def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
+        search_every: int = 1) -> tuple[dict, object, dict]:
     """(record, Result, standardised residuals) of ``spec`` on ``data``: maximum, posterior, ELPD-LOO, misfit per
-    group, indices."""
+    group, indices. ``search_every``: the global search on every n-th row, its optimum polished on all
+    (``optimum.find_optimum_on_every``)."""
     start = time.perf_counter()
     post = Posterior.build(data, model_for(data, spec))
-    best, centre = find_optimum_profiled(post, np.random.default_rng(seed), evaluations=3000)
+    best, centre = find_optimum_on_every(post, search_every, np.random.default_rng(seed), evaluations=3000)
     found = time.perf_counter() - start
     print(f"  {spec}: maximum {best:.1f} in {found:.0f} s; posterior by {method}", flush=True)
     inv, refusal = (laplace_fit(post, centre, seed=seed) if method == "laplace" else (None, "emcee asked for"))
@@ -279,6 +283,8 @@ def main(argv=None) -> int:
     parser.add_argument("--posterior", choices=("laplace", "emcee"), default="laplace")
     parser.add_argument("--max-steps", type=int, default=4000)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--search-every", type=int, default=1, help="the global search of each model's maximum on "
+                        "every n-th row only, then polished on all rows (8 for the whole file at four wavelengths)")
     parser.add_argument("--out", default="reports/ptfe_models")
     args = parser.parse_args(argv)
     try:  # every model named, before any work
@@ -302,7 +308,7 @@ def main(argv=None) -> int:
           f"load {os.getloadavg()[0]:.2f}", flush=True)
     records, pointwise, misfit = [], {}, None
     for spec in args.models.split(","):
-        record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise)
+        record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise, args.search_every)
         records.append(record)
         pointwise[spec] = np.asarray(inv.loo["pointwise"])
         table = ranking(records, pointwise)

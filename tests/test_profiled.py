@@ -100,3 +100,21 @@ def test_a_branch_is_the_posterior_with_its_parameters_held_and_compiles_nothing
     moved = branch.expand(theta)
     moved[:, parent.priors.names.index("k")] = 0.3  # negative control: another k is another posterior
     assert np.all(np.abs(parent.log_prob(moved) - value) > 1e-6)
+
+
+def test_the_search_on_every_other_row_ends_where_the_search_on_all_does():
+    """``find_optimum_on_every``: the global search on a subset of the rows (the same priors: ``Posterior.on_rows``
+    keeps the measured noise floors), polished on all rows, reaches the full search's maximum on a set whose
+    optimum the subset pins; the subset posterior itself is the full one's rows only (the control)."""
+    from spacepol.infer.optimum import find_optimum_on_every, find_optimum_profiled
+
+    data, model = _dataset()
+    post = Posterior.build(data, model, noise_floor=False)
+    half = post.on_rows(np.arange(0, len(data), 2))
+    assert half.priors is post.priors and len(half.likelihood.data) == (len(data) + 1) // 2
+    theta = post.priors.rescale(np.random.default_rng(1).random((4, post.ndim)))
+    assert not np.allclose(half.log_prob(theta), post.log_prob(theta))
+    full, _ = find_optimum_profiled(post, np.random.default_rng(0), evaluations=1500)
+    value, best = find_optimum_on_every(post, 2, np.random.default_rng(0), evaluations=1500)
+    assert value == pytest.approx(float(post.log_prob(best[None, :])[0]), rel=1e-12)
+    assert value == pytest.approx(full, abs=0.05), f"every other row {value:.3f}, all rows {full:.3f}"

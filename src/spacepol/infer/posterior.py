@@ -53,6 +53,16 @@ class Posterior:
     _checked = False
     _where = "priors"
 
+    def on_rows(self, rows) -> "Posterior":
+        """The same model, observables and priors (noise floors included) on a subset of the data's rows (indices or
+        a boolean mask): e.g. a cheaper posterior for a global search whose optimum is then polished on every row."""
+        likelihood = self.likelihood
+        subset = Likelihood(likelihood.data.select(rows), likelihood.model, observables=likelihood.observable_names,
+                            robust=likelihood.robust, nu=likelihood.nu)
+        posterior = type(self)(subset, self.priors)
+        posterior.measured_noise, posterior._where = getattr(self, "measured_noise", {}), self._where
+        return posterior
+
     def ensure_checked(self) -> "Posterior":
         """``check_support`` once (a posterior built with ``check=False``); returns the posterior."""
         if not self._checked:

@@ -1,13 +1,17 @@
 """The JAX forward model reproduces the numpy/numba implementation it replaced (``tests/data/forward_corpus.npz``,
 recorded by ``tests/data/make_forward_corpus.py`` at commit 7870214) to 1e-12: Stokes vectors, Mueller
-matrices and DOP for every built-in effect over the whole prior support, special geometries included."""
+matrices and DOP for every built-in effect over the whole prior support, special geometries included. The one
+intended change since: ``subsurface``'s internal reflectance is now the exact average, where the corpus summed it
+on SCATMECH's 0.2 deg grid; its albedo is mapped so that rho_s / (1 - rho_i rho_s) is the corpus's."""
 
 import pathlib
 
 import numpy as np
 import pytest
 
+from internal_reflectance import scatmech_grid
 from spacepol.physics import Geometry, Model
+from spacepol.physics.fresnel import hemispherical_internal_reflectance
 
 CORPUS = np.load(pathlib.Path(__file__).parent / "data" / "forward_corpus.npz")
 MODELS = sorted({key.split("/")[0] for key in CORPUS.files if key.count("/") == 0 and key.startswith("model")})
@@ -19,6 +23,9 @@ def cases(model_key):
     for prefix in prefixes:
         params = {key.rsplit("/", 1)[1]: CORPUS[key] for key in CORPUS.files if key.startswith(prefix + "/param/")}
         params = {k: (float(v) if v.ndim == 0 else v) for k, v in params.items()}
+        if "rho_s" in params:  # x / (1 - rho_i x) = c, c = rho_s / (1 - rho_i_grid rho_s)
+            c = params["rho_s"] / (1.0 - scatmech_grid(params["n"]) * params["rho_s"])
+            params["rho_s"] = c / (1.0 + np.asarray(hemispherical_internal_reflectance(params["n"])) * c)
         ti, tr, dphi, wl = CORPUS[prefix + "/geometry"]
         yield prefix, params, Geometry(ti, tr, dphi, wl)
 

@@ -11,6 +11,7 @@ import pytest
 from spacepol.physics import Geometry, Model
 from spacepol.physics import facets
 from spacepol.physics.builtin_effects import Smith
+from internal_reflectance import scatmech_grid, walton
 
 # (theta_i, theta_r, phi_s) in degrees, SCATMECH's phi_s = 0 is the specular direction,
 # which is dphi = 180 - phi_s in spacepol's convention.
@@ -137,30 +138,6 @@ def test_walter_fit_is_close_to_exact_smith():
         assert np.max(np.abs(fit - exact) / np.maximum(exact, 1e-3)) < 0.0035
 
 
-def _scatmech_grid_internal_reflectance(n):
-    """The internal hemispherical reflectance as SCATMECH's Diffuse_Subsurface_BRDF_Model sums it: the unpolarized
-    Fresnel reflectance from inside (1 beyond the critical angle), cosine-weighted, 0 to 90 deg in 0.2 deg steps."""
-    theta = np.linspace(0.0, 0.5 * np.pi, 451)
-    sin_t = n * np.sin(theta)
-    cos_t = np.sqrt(np.maximum(0.0, 1.0 - sin_t**2))
-    c = np.cos(theta)
-    r_s = ((n * c - cos_t) / (n * c + cos_t)) ** 2
-    r_p = ((c - n * cos_t) / (c + n * cos_t)) ** 2
-    r = np.where(sin_t >= 1.0, 1.0, 0.5 * (r_s + r_p))
-    weights = np.sin(2.0 * theta)
-    return float(np.sum(r * weights) / np.sum(weights))
-
-
-def _walton_internal_reflectance(n):
-    """The internal hemispherical (cosine-weighted) reflectance of a dielectric of index n > 1 in closed form:
-    1 - (1 - r_e) / n^2, with r_e the external one (Walton, Proc. R. Soc. A 1917; Stern, Appl. Opt. 3, 111 (1964))."""
-    r_e = (0.5 + (n - 1) * (3 * n + 1) / (6 * (n + 1) ** 2)
-           + n**2 * (n**2 - 1) ** 2 / (n**2 + 1) ** 3 * np.log((n - 1) / (n + 1))
-           - 2 * n**3 * (n**2 + 2 * n - 1) / ((n**2 + 1) * (n**4 - 1))
-           + 8 * n**4 * (n**4 + 1) / ((n**2 + 1) * (n**4 - 1) ** 2) * np.log(n))
-    return 1.0 - (1.0 - r_e) / n**2
-
-
 def test_internal_reflectance_is_waltons_closed_form():
     """The subsurface term's recycled share: the internal hemispherical reflectance equals Walton's closed form to
     1e-12 from n 1.02 to 4, and it is smooth in n (central differences at two steps agree with the closed form's
@@ -169,14 +146,14 @@ def test_internal_reflectance_is_waltons_closed_form():
 
     n = np.linspace(1.02, 4.0, 150)
     ours = np.asarray(hemispherical_internal_reflectance(n))
-    np.testing.assert_allclose(ours, _walton_internal_reflectance(n), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ours, walton(n), rtol=0, atol=1e-12)
     centre = np.array([1.016, 1.2, 1.35, 1.5])
-    exact = (_walton_internal_reflectance(centre + 1e-6) - _walton_internal_reflectance(centre - 1e-6)) / 2e-6
+    exact = (walton(centre + 1e-6) - walton(centre - 1e-6)) / 2e-6
     for h in (1e-4, 1e-7):
         slope = (np.asarray(hemispherical_internal_reflectance(centre + h))
                  - np.asarray(hemispherical_internal_reflectance(centre - h))) / (2 * h)
         np.testing.assert_allclose(slope, exact, rtol=1e-4, err_msg=f"step {h:g}")
-    grid = np.array([(_scatmech_grid_internal_reflectance(c + 1e-7) - _scatmech_grid_internal_reflectance(c - 1e-7)) / 2e-7
+    grid = np.array([(scatmech_grid(c + 1e-7) - scatmech_grid(c - 1e-7)) / 2e-7
                      for c in centre])
     assert np.max(np.abs(grid / exact - 1)) > 0.1, f"the grid's slopes {grid} should miss the closed form's {exact}"
 
@@ -196,7 +173,7 @@ def test_subsurface_mueller_matches_scatmech(n, albedo):
     # spacepol computes, ``test_internal_reflectance_is_waltons_closed_form``): its recycled share, used here
     from spacepol.physics.fresnel import hemispherical_internal_reflectance
 
-    ours = ours * (1 - hemispherical_internal_reflectance(n) * albedo) / (1 - _scatmech_grid_internal_reflectance(n) * albedo)
+    ours = ours * (1 - hemispherical_internal_reflectance(n) * albedo) / (1 - scatmech_grid(n) * albedo)
     for j, (a, b, c) in enumerate(GEOMETRIES):
         theirs = np.array(peer.MuellerBRDF(np.radians(a), np.radians(b), np.radians(c)))
         np.testing.assert_allclose(ours[:, :, j], theirs, rtol=0, atol=1e-6 * theirs[0, 0], err_msg=f"geometry {GEOMETRIES[j]}")

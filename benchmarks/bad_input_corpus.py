@@ -229,7 +229,7 @@ CASES = [
                      "    def lobe(self, ctx):\n        return ctx.depolarized(0.01 + 0 * ctx.geometry.cos_tr)\n", "d.csv": GOOD},
      ["--effect", "p.py:P", "forward", "d.csv", "--model", "paper+p_ok", "--out", "f.csv"], "ok"),
     ("run short capped", {"d.csv": GOOD_BRDF}, ["run", "d.csv", "--steps", "500", "--quiet", "--out", "r"], "ok"),
-    # accepted before session 20 (issue 25, item 8)
+    # inputs once accepted (issue 25, item 8)
     ("a row of only commas", {"d.csv": GOOD + ",,\n"}, ["run", "d.csv", "--out", "r"], "error"),
     ("stokes |S| > S0 fitted as q", {"d.csv": "theta_i,theta_r,s0,s1,s2\n" + "".join(
         f"{ti},{tr},1.0,{1.5 if tr == 35 else 0.3},0.1\n" for ti in (10, 30, 50) for tr in (5, 20, 35, 50, 65))},

@@ -4,8 +4,8 @@
 
 Model `specular+smith+body+lambertian+oxide_layer` on the 278-geometry PTFE set at 0.633 um (chosen as
 ``benchmarks/laplace_vs_emcee.py`` chooses it). The low-index mode is found by the same search with n held in
-[0.6, 1.0], then polished with n free. Session 19's global multistart found a mode at n ~ 1.8, k ~ 1.8;
-session 21's nested sampling (two replicates) put all the mass near n 0.75, k 0.06. Here: both modes polished, their
+[0.6, 1.0], then polished with n free. A global multistart found a mode at n ~ 1.8, k ~ 1.8;
+nested sampling (two replicates) put all the mass near n 0.75, k 0.06. Here: both modes polished, their
 log posterior, the Laplace evidence of each (ln p(mode) + D/2 ln 2 pi + 1/2 ln det Sigma in the sampling space)
 and the importance-sampling evidence of the Laplace proposal at each (with its Pareto k: where k > 0.7 it is not to
 be trusted). The mode with the larger evidence holds the mass; the other is where a start search can strand a chain.

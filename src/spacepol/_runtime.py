@@ -21,11 +21,11 @@ region of at most 64 MiB that glibc shrinks and maps again). Measured on that ev
 18 M evaluations/s as glibc starts, 44-54 without mmap'ed blocks, 106 with one arena as well. Freed memory
 at the top of the heap is given back to the system only above 2 GiB (mallopt's largest value; a quarter of
 the machine's memory where that is less, at least 1 GiB): an output larger than the trim threshold (128 MB
-before) was returned when freed and page-faulted in again on the next call. Measured (session 9, 64 sets x
+before) was returned when freed and page-faulted in again on the next call. Measured (64 sets x
 100,000 geometries, an 819 MB Mueller output): 15 -> 50 M evaluations/s, the DOP alone 85 -> 230 M/s. A fixed
 1 GiB was not enough for a caller that keeps the previous output while the next is computed (two outputs and
 the program's temporaries, ~2 GB): 143,000 page faults per call, 21 M evaluations/s; with 2 GiB or more none
-after the first calls, 44-48 M/s (session 12, this 24 GB machine, alternated processes). The cost: a process
+after the first calls, 44-48 M/s (a 24 GB machine, alternated processes). The cost: a process
 that once held large arrays keeps up to that much freed memory (its resident size stays near its peak). An
 explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ /
 MALLOC_MMAP_MAX_ / MALLOC_ARENA_MAX is kept.

@@ -101,7 +101,7 @@ def batch_of(values: dict) -> tuple:
 def once(value, shape):
     """A hook's output that does not vary over parameter sets (the paper's shadowing at fixed constants)
     computed once: without the barrier XLA fuses it into every (set, geometry) element that uses it.
-    Checked in session 8 on the `paper` DOP program: XLA's CPU compiler removes the barrier, and the compiled
+    Checked on the `paper` DOP program: XLA's CPU compiler removes the barrier, and the compiled
     fusions are the same without it (the shadowing is its own 84-element fusion either way: a value broadcast
     over the sets is not fused with its expensive producer); kept for other backends, not measured there."""
     if value is None or len(shape) < 2 or np.ndim(value) == 0 or np.shape(value)[-2:-1] == shape[-2:-1]:

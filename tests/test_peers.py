@@ -11,6 +11,7 @@ import pytest
 from spacepol.physics import Geometry, Model
 from spacepol.physics import facets
 from spacepol.physics.builtin_effects import Smith
+from spacepol.physics.fresnel import hemispherical_internal_reflectance
 from internal_reflectance import scatmech_grid, walton
 
 # (theta_i, theta_r, phi_s) in degrees, SCATMECH's phi_s = 0 is the specular direction,
@@ -142,8 +143,6 @@ def test_internal_reflectance_is_waltons_closed_form():
     """The subsurface term's recycled share: the internal hemispherical reflectance equals Walton's closed form to
     1e-12 from n 1.02 to 4, and it is smooth in n (central differences at two steps agree with the closed form's
     slope), where a fixed grid of angles has a cusp each time the critical angle crosses a node (the control)."""
-    from spacepol.physics.fresnel import hemispherical_internal_reflectance
-
     n = np.linspace(1.02, 4.0, 150)
     ours = np.asarray(hemispherical_internal_reflectance(n))
     np.testing.assert_allclose(ours, walton(n), rtol=0, atol=1e-12)
@@ -153,8 +152,7 @@ def test_internal_reflectance_is_waltons_closed_form():
         slope = (np.asarray(hemispherical_internal_reflectance(centre + h))
                  - np.asarray(hemispherical_internal_reflectance(centre - h))) / (2 * h)
         np.testing.assert_allclose(slope, exact, rtol=1e-4, err_msg=f"step {h:g}")
-    grid = np.array([(scatmech_grid(c + 1e-7) - scatmech_grid(c - 1e-7)) / 2e-7
-                     for c in centre])
+    grid = (scatmech_grid(centre + 1e-7) - scatmech_grid(centre - 1e-7)) / 2e-7
     assert np.max(np.abs(grid / exact - 1)) > 0.1, f"the grid's slopes {grid} should miss the closed form's {exact}"
 
 
@@ -171,20 +169,16 @@ def test_subsurface_mueller_matches_scatmech(n, albedo):
         {"n": n, "k": 0.0, "sigma": 0.2, "ks": 0.0, "rho_s": albedo}, Geometry(ti, tr, 180.0 - ps), mueller=True).mueller
     # SCATMECH averages the internal reflectance on a 0.2 deg grid (off by up to 3e-4 of the exact average that
     # spacepol computes, ``test_internal_reflectance_is_waltons_closed_form``): its recycled share, used here
-    from spacepol.physics.fresnel import hemispherical_internal_reflectance
-
-    ours = ours * (1 - hemispherical_internal_reflectance(n) * albedo) / (1 - scatmech_grid(n) * albedo)
+    as_scatmech = ours * (1 - hemispherical_internal_reflectance(n) * albedo) / (1 - scatmech_grid(n) * albedo)
     for j, (a, b, c) in enumerate(GEOMETRIES):
         theirs = np.array(peer.MuellerBRDF(np.radians(a), np.radians(b), np.radians(c)))
-        np.testing.assert_allclose(ours[:, :, j], theirs, rtol=0, atol=1e-6 * theirs[0, 0], err_msg=f"geometry {GEOMETRIES[j]}")
+        np.testing.assert_allclose(as_scatmech[:, :, j], theirs, rtol=0, atol=1e-6 * theirs[0, 0], err_msg=f"geometry {GEOMETRIES[j]}")
     # negative controls: without the recycled light, or without the 1/n^2, the comparison fails
     no_recycling = Model.from_string("specular+polarized_diffuse").evaluate(
         {"n": n, "k": 0.0, "sigma": 0.2, "ks": 0.0, "rho_pd": albedo / n**2}, Geometry(ti, tr, 180.0 - ps), mueller=True).mueller
     theirs = np.array(peer.MuellerBRDF(*np.radians(GEOMETRIES[0])))
     assert abs(no_recycling[0, 0, 0] - theirs[0, 0]) > 1e-3 * theirs[0, 0]
     # the declared twin: polarized_diffuse with rho_pd = rho_s / (n^2 (1 - rho_i rho_s)) is the same matrix
-    ours = Model.from_string("specular+subsurface").evaluate(
-        {"n": n, "k": 0.0, "sigma": 0.2, "ks": 0.0, "rho_s": albedo}, Geometry(ti, tr, 180.0 - ps), mueller=True).mueller
     rho_pd = albedo / (n**2 * (1 - hemispherical_internal_reflectance(n) * albedo))
     twin = Model.from_string("specular+polarized_diffuse").evaluate(
         {"n": n, "k": 0.0, "sigma": 0.2, "ks": 0.0, "rho_pd": rho_pd}, Geometry(ti, tr, 180.0 - ps), mueller=True).mueller

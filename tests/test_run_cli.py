@@ -121,7 +121,9 @@ def test_ptfe_run_by_laplace_explains_the_index(tmp_path):
     # the walkers' spread over the importance draws sits near its limit here (1.075 x against 1.08 on an Intel Xeon):
     # either engine is a right outcome, as long as the run says which one ran and why
     if s["engine"] == "laplace-is":
-        assert d["pareto_k"] < 0.7 and d["ess_min"] >= 100 and d["sd_growth_max"] <= 1.08, d
+        from spacepol.infer.spread_check import MAX_SD_GROWTH
+
+        assert d["pareto_k"] < 0.7 and d["ess_min"] >= 100 and d["sd_growth_max"] <= MAX_SD_GROWTH, d
     else:
         assert s["engine"] == "emcee" and "spread" in s["laplace_refused"] and d["rhat_max"] < 1.05, (s["engine"], d)
     assert s["observables_not_fitted"] == {"dop": "mueller", "stokes": "mueller"}

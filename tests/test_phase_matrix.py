@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from coherency import coherency_eigenvalues
+
 from spacepol.criticism.reciprocity import reciprocal_image, swapped
 from spacepol.errors import ParameterError
 from spacepol.physics import Geometry, Model, constrained_phase
@@ -17,16 +19,6 @@ pytest.importorskip("pySCATMECH")
 
 WAVELENGTH = 0.633
 MODEL = Model.from_string("specular+phase_matrix")
-
-# Stokes-basis Pauli matrices: the Cloude coherency matrix H = 1/4 sum_ij M_ij sigma_i (x) conj(sigma_j)
-_SIGMA = [np.eye(2), np.diag([1.0, -1.0]), np.array([[0.0, 1.0], [1.0, 0.0]]), np.array([[0.0, -1j], [1j, 0.0]])]
-_BASIS = np.array([[np.kron(a, b.conj()) for b in _SIGMA] for a in _SIGMA])
-
-
-def coherency_eigenvalues(mueller):
-    """Eigenvalues of the Cloude coherency matrix of Mueller matrices (..., 4, 4), ascending: all >= 0 exactly when
-    the matrix is a sum of non-depolarizing ones (physically realizable)."""
-    return np.linalg.eigvalsh(np.einsum("...ij,ijab->...ab", mueller, _BASIS) / 4)
 
 
 def _draw(rng):

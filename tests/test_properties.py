@@ -14,7 +14,7 @@ MODELS = [
     "specular+shadowing+body+polarized_diffuse+depolarization+extinction+dop_bias",
     "specular+smith+ggx+body",
     "specular+smith+subsurface+volume",
-    "specular+shadowing+lambertian+volume_rayleigh",
+    "specular+shadowing+lambertian+volume_rayleigh+polarization_memory",
     "specular+smith+subsurface+phase_matrix",
 ]
 

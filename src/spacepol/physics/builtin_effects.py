@@ -11,6 +11,7 @@ from .effect import Context, Effect, Ratio
 from .parameter import Parameter
 from .shadowing import PAPER_CONSTANTS, paper_shadowing
 from .phase_matrix import PhaseMatrix
+from .polarization_memory import PolarizationMemory
 from .volume import Volume, VolumeRayleigh
 
 
@@ -405,6 +406,6 @@ class Lambertian(Effect):
 BUILTIN_EFFECTS = (
     Specular, Shadowing, Smith, Body, PolarizedDiffuse, Depolarization,
     Anisotropy, GGX, OxideLayer, AngleOffset, Extinction, DopBias, Lambertian, Subsurface, Volume, VolumeRayleigh,
-    PhaseMatrix,
+    PhaseMatrix, PolarizationMemory,
 )
 PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}

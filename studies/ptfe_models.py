@@ -2,7 +2,7 @@
 which model reaches the noise the measurement shows itself, and what each says about the index.
 
     python studies/ptfe_models.py [--wavelength-um all] [--in-plane] [--mask-anisotropic]
-                                  [--models paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix]
+                                  [--models paper,...,specular+smith+subsurface+phase_matrix+polarization_memory]
                                   [--posterior laplace|emcee] [--max-steps 4000] [--search-every 1] [--seed 0]
                                   [--out reports/ptfe_models]
 
@@ -16,12 +16,14 @@ which model reaches the noise the measurement shows itself, and what each says a
    narrower than 0.3; physical for porous PTFE inside [1.15, 1.45]).
 4. A table ranking the models by ELPD-LOO with the SE of each difference, and a figure of where the best model's
    misfit sits (element x geometry, per wavelength, in units of the measured noise).
-The report (``report.md``, ``study.json``) is rewritten after each model, so an interrupted study keeps what it measured.
+The report (``report.md``, ``study.json``) is rewritten after each model, with each model's pointwise ELPD-LOO in
+``pointwise/``: the same command run again keeps the models already fitted under the same settings and fits the rest.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import time
@@ -47,7 +49,8 @@ from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
 from spacepol.physics.spectral import SpectralModel, wavelength_label  # noqa: E402
 
-MODELS = "paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix"
+MODELS = ("paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix,"
+          "specular+smith+subsurface+phase_matrix+polarization_memory")
 # sintered PTFE: grains of index 1.35 (Polymer Handbook, 4th ed., 1999), 30-40 % pores; an effective interface index
 # between the porous surface's and the grains' (Germer, SPIE 10655, 2018)
 PTFE_BAND = (1.15, 1.45)
@@ -274,6 +277,24 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
     write_text(out / "report.md", "\n".join(lines) + "\n")
 
 
+def pointwise_file(out: Path, spec: str) -> Path:
+    """Where a model's pointwise ELPD-LOO is kept (the ranking's paired differences need it)."""
+    return out / "pointwise" / f"{spec.replace('+', '_')}.npy"
+
+
+def finished(out: Path, settings: dict) -> tuple[dict, dict | None, str | None]:
+    """What an earlier run of the same settings in ``out`` measured: ({model: record} for the models whose pointwise
+    ELPD-LOO was kept, the misfit map's record, the model it maps); nothing where the settings differ."""
+    try:
+        old = json.loads((out / "study.json").read_text())
+    except (OSError, ValueError):
+        return {}, None, None
+    if old.get("settings") != settings:
+        return {}, None, None
+    done = {r["model"]: r for r in old.get("records", []) if pointwise_file(out, r["model"]).is_file()}
+    return done, old.get("misfit"), old.get("misfit_model")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--wavelength-um", default="all")
@@ -306,19 +327,33 @@ def main(argv=None) -> int:
         data = data.in_plane()
     print(f"PTFE: {len(data)} geometries ({masked} anisotropic rows left out); {os.cpu_count()} cores, "
           f"load {os.getloadavg()[0]:.2f}", flush=True)
-    records, pointwise, misfit = [], {}, None
+    settings = {k: getattr(args, k) for k in ("wavelength_um", "in_plane", "mask_anisotropic", "posterior", "max_steps",
+                                              "seed", "search_every")}
+    done, misfit, misfit_model = finished(out, settings)
+    records, pointwise = [], {}
     for spec in args.models.split(","):
-        record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise, args.search_every)
+        if spec in done:  # the same command ran this model before: its record and pointwise ELPD are kept
+            record, inv, standard = done[spec], None, None
+            pointwise[spec] = np.load(pointwise_file(out, spec))
+            print(f"  {spec}: kept from {out / 'study.json'} (ELPD-LOO {record['elpd_loo']:.1f})", flush=True)
+        else:
+            record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise, args.search_every)
+            pointwise[spec] = np.asarray(inv.loo["pointwise"])
+            pointwise_file(out, spec).parent.mkdir(exist_ok=True)
+            np.save(pointwise_file(out, spec), pointwise[spec])
         records.append(record)
-        pointwise[spec] = np.asarray(inv.loo["pointwise"])
         table = ranking(records, pointwise)
-        if table[0]["model"] == spec:
+        if table[0]["model"] == spec and inv is not None:
             fig, misfit = misfit_map(inv, standard)
+            misfit_model = spec
             save_figure(fig, out / "misfit.png")
-        write_json(out / "study.json", {"records": records, "ranking": table, "measured_noise": noise,
+        elif table[0]["model"] != misfit_model:
+            misfit = None  # the best model was kept from an earlier run that did not map its misfit
+        write_json(out / "study.json", {"settings": settings, "records": records, "ranking": table,
+                                        "measured_noise": noise,
                                         "anisotropy": {w: {"pairs": len(a.pairs), "flagged": int(a.flagged.sum()),
                                                            "chi2_per_dof": a.excess} for w, (a, _) in aniso.items()},
-                                        "masked_rows": masked, "misfit": misfit})
+                                        "masked_rows": masked, "misfit": misfit, "misfit_model": misfit_model})
         write_report(out, args, data, noise, aniso, masked, records, table, misfit)
         print(f"  {spec}: ELPD-LOO {record['elpd_loo']:.1f} +- {record['elpd_loo_se']:.1f} ({record['engine']}, "
               f"{record['seconds']:.0f} s)", flush=True)

@@ -1,6 +1,6 @@
 """Which mode the start-point search ends in, plain or with the noise levels profiled out (issue 24, item 5).
 
-On NIST's PTFE at all four wavelengths with ``paper+polarized_diffuse`` (the README's command), every search
+On NIST's PTFE at all four wavelengths with ``paper+polarized_diffuse`` (the command in docs/getting-started.md), every search
 stream of ``modes.search_modes`` runs once as ``optimum.find_optimum`` (without profiling) and once as
 ``optimum.find_optimum_profiled`` (today's), for ``--seeds`` seeds x ``--streams`` streams; each line gives the
 log posterior it ended at and the seconds it took, and the table counts the distinct modes (within

@@ -55,7 +55,8 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
+    """The `invert-mcmc` argument parser: every command, option and its help (the CLI reference is generated from it)."""
     parser = _Parser(prog="invert-mcmc", description="Probabilistic inversion of polarimetric reflectance.")
     parser.add_argument("--effect", action="append", default=[], metavar="FILE.py:NAME",
                         help="load a user-defined effect (repeatable); it is then usable by name")
@@ -219,7 +220,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """``invert-mcmc``: parse ``argv`` (default sys.argv), opt in to the process settings, run the command; a
     SpacepolError becomes one line on stderr and exit status 2. Returns the exit status."""
-    args = _parser().parse_args(argv)
+    args = build_parser().parse_args(argv)
     import os
     import warnings
 

@@ -18,7 +18,7 @@ Where the sampler starts (``find_optimum_profiled``, run by ``modes.search_modes
 posterior with its noise levels profiled out (``profiled``), a multistart runs on each branch too, and every
 search's optimum is polished on the full posterior. On PTFE at four wavelengths (``paper+polarized_diffuse``) no
 plain search of 9 reached the best mode and 6-8 of 9 profiled ones do (``benchmarks/start_search_modes.py``,
-reports/benchmarks.md). Profiling alone is not what finds it: the cube's profiled optimum is a mode ~6,000 log
+docs/benchmarks-log.md). Profiling alone is not what finds it: the cube's profiled optimum is a mode ~6,000 log
 units lower, and only the dielectric branch's multistart, polished in full, leaves it.
 """
 

@@ -1,6 +1,6 @@
 """Nested sampling with nautilus (Lange 2023, MNRAS 525, 3181): the posterior and the Bayesian evidence ln Z.
 
-Chosen over dynesty by measurement (``benchmarks/nested_choice.py``, figures in the README): on the paper's
+Chosen over dynesty by measurement (``benchmarks/nested_choice.py``, figures in docs/benchmarks-log.md): on the paper's
 posterior nautilus gave more effective draws per second, evaluating the likelihood in the batches the compiled
 likelihood is built for.
 

@@ -83,3 +83,28 @@ class Described:
         del sys.modules[module.__name__]
     assert sorted(undocumented([module])) == ["spacepol_fake.Bare", "spacepol_fake.Bare.method", "spacepol_fake.Bare.value",
                                               "spacepol_fake.Record", "spacepol_fake.bare"]
+
+
+def long_module_docstrings(paths, limit: int = 10) -> list[str]:
+    """'path: N lines' for each module in ``paths`` whose docstring runs past ``limit`` lines."""
+    import ast
+
+    out = []
+    for path in paths:
+        doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")), clean=False)
+        if doc and len(doc.strip().splitlines()) > limit:
+            out.append(f"{path}: {len(doc.strip().splitlines())} lines")
+    return out
+
+
+def test_a_module_docstring_says_what_the_module_is_for_in_ten_lines(tmp_path):
+    """The long form (why, what was measured) lives on the documentation's internals page. Control: an eleven-line
+    docstring is found."""
+    from pathlib import Path
+
+    package = Path(spacepol.__file__).parent
+    found = long_module_docstrings(sorted(package.rglob("*.py")))
+    assert not found, "; ".join(found)
+    long = tmp_path / "long.py"
+    long.write_text('"""' + "\n".join(f"line {i}" for i in range(11)) + '"""\n', encoding="utf-8")
+    assert long_module_docstrings([long]) == [f"{long}: 11 lines"]

@@ -1,21 +1,11 @@
 """spacepol: probabilistic inversion of polarimetric reflectance.
 
-The Python API (:mod:`spacepol.api`, every name below) is what the ``invert-mcmc`` command line calls:
+The Python API (:mod:`spacepol.api`) is what the ``invert-mcmc`` command line calls: ``load``, ``invert``,
+``diagnose``, ``contrast``, ``observe``, ... and the ``Result`` every engine returns. The names are imported on
+first use, so ``import spacepol`` stays light, and importing it changes no process-wide setting
+(``configure_process`` opts in to the command line's speed settings).
 
-    import spacepol
-    data = spacepol.load("data/ptfe/ptfe_mueller_brdf.csv", wavelength_um=0.633, in_plane=True)
-    result = spacepol.invert(data, "paper", seed=0)       # a Result: ArviZ groups, diagnostics, model spec
-    result.save("runs/ptfe"); again = spacepol.Result.load("runs/ptfe")
-    table3 = spacepol.contrast(again)                     # the paper's Table 3 as distributions
-
-Physics lives in :mod:`spacepol.physics` (the forward pBRDF model built from effects), measurements in
-:mod:`spacepol.io`, inference in :mod:`spacepol.infer`, criticism in :mod:`spacepol.criticism`, reports in
-:mod:`spacepol.report`. The names are imported on first use, so ``import spacepol`` stays light.
-
-Importing it changes no process-wide setting. The command line opts in to the settings that decide speed on a
-small shared machine (one BLAS thread, a kept heap, JAX's wide vectors and on-disk compilation cache) with
-:func:`configure_process`; a library user may call it too. JAX's double precision, which the physics needs, is
-turned on where spacepol first builds a model or compiles a program (``_runtime.ensure_double_precision``).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 __version__ = "0.1.0"

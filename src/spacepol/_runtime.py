@@ -3,59 +3,7 @@ keeps freed memory.
 
 One BLAS thread unless the user says otherwise.
 
-spacepol's linear algebra is on matrices the size of the parameter vector (L-BFGS-B's updates,
-covariances), where BLAS threads cannot help; but they spin while the model's threads hold the cores,
-and each tiny call then waits for a time slice. Measured on this 2-core machine: L-BFGS-B polishing
-of the paper model 40x slower (0.3 s instead of 7 ms per start), one diagnose round 71 s -> 31 s.
-Set before numpy or scipy load BLAS (the environment variable); libraries already loaded are limited
-through threadpoolctl. An explicit OPENBLAS_NUM_THREADS / OMP_NUM_THREADS / MKL_NUM_THREADS is kept.
-
-A heap that keeps freed memory (glibc): numpy's temporaries of a full-Mueller evaluation are megabytes
-each (4 x 4 x walkers x geometries), above glibc's default mmap threshold, so every one was mapped,
-page-faulted in and unmapped again. Measured on the four-wavelength PTFE likelihood (20 walkers x 7,296
-geometries): 38.7 ms per call, 11.8 of them in the kernel; with the heap kept, 22.9 ms and none. glibc
-caps that threshold at 32 MiB, and a full-Mueller output is larger (4 x 4 x 4,096 sets x 84 geometries
-= 44 MB): such blocks come from the heap too (no mmap'ed blocks at all; glibc still maps one when the heap
-cannot grow), and XLA's threads allocate from the same heap (one arena: a thread's own arena is an mmap'ed
-region of at most 64 MiB that glibc shrinks and maps again). Measured on that evaluation, interleaved:
-18 M evaluations/s as glibc starts, 44-54 without mmap'ed blocks, 106 with one arena as well. Freed memory
-at the top of the heap is given back to the system only above 2 GiB (mallopt's largest value; a quarter of
-the machine's memory where that is less, at least 1 GiB): an output larger than the trim threshold (128 MB
-before) was returned when freed and page-faulted in again on the next call. Measured (64 sets x
-100,000 geometries, an 819 MB Mueller output): 15 -> 50 M evaluations/s, the DOP alone 85 -> 230 M/s. A fixed
-1 GiB was not enough for a caller that keeps the previous output while the next is computed (two outputs and
-the program's temporaries, ~2 GB): 143,000 page faults per call, 21 M evaluations/s; with 2 GiB or more none
-after the first calls, 44-48 M/s (a 24 GB machine, alternated processes). The cost: a process
-that once held large arrays keeps up to that much freed memory (its resident size stays near its peak). An
-explicit MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ /
-MALLOC_MMAP_MAX_ / MALLOC_ARENA_MAX is kept.
-
-JAX in double precision: the forward model is JAX code, and polarization near the specular peak and
-Fresnel reflectances of nearly index-matched media need float64 (float32 loses R ~ 1e-17 and DOP's
-differences of nearly equal numbers). JAX's default is float32; spacepol switches it on for the process.
-
-Wide vectors where the CPU has them: XLA compiles for 256-bit vectors even on a CPU with AVX-512. On
-AVX-512 (read from /proc/cpuinfo) spacepol asks for 512-bit ones (``--xla_cpu_prefer_vector_width=512``
-appended to XLA_FLAGS before JAX starts its CPU backend; an XLA_FLAGS that names the option is kept).
-Measured on this machine's AMD EPYC, interleaved in one process: the paper's DOP 275 -> 335 M
-evaluations/s, a fully fused DOP kernel 339 -> 481 M/s. The results are the same numbers (the
-forward-model corpus test holds at 1e-12 either way).
-
-Small calls on the calling thread, in the processes that make them (``inline_small_calls``: the command
-line and batch jobs; ``jax_cpu_enable_async_dispatch`` off before JAX creates its CPU backend; an explicit
-JAX_CPU_ENABLE_ASYNC_DISPATCH is kept). A sampler calls the model with a few dozen parameter sets, and
-handing each call to a worker thread and waiting for it cost more than the call: the paper's DOP for 16
-sets x 84 geometries 96-153 -> 52-57 us, the DOP likelihood over 4,096 sets (blocks of 256) 100 -> 140 M
-evaluations/s, the 84-point posterior (``benchmarks/inversion_speed.py``) 3.0 -> 2.3 s with the same draws.
-A plain ``import spacepol`` keeps JAX's default: one large evaluation loses on the calling thread (paper's
-full Mueller matrix, 4,096 x 84: 82 -> 49 M evaluations/s; DOP 400 -> 280-356), measured alternately in
-separate processes (``benchmarks/forward_speed.py --quick``).
-
-JAX's compiled programs kept on disk: every model structure and batch size is compiled once (0.2 s for the
-paper's DOP likelihood, 1-2 s for a full-Mueller one), and without a cache every command compiles them
-again. Kept in $SPACEPOL_CACHE_DIR, else $XDG_CACHE_HOME/spacepol/jax or ~/.cache/spacepol/jax (entries
-of 0.1-1 MB, one per model structure and batch size; delete the folder at will); SPACEPOL_CACHE_DIR=""
-turns it off. A cache folder that cannot be written only costs the compilations.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 import ctypes

@@ -6,9 +6,7 @@
     again = spacepol.Result.load("runs/ptfe")
     table3 = spacepol.contrast(again)                                  # a Contrast
 
-The functions check their input as the command line does and raise :class:`spacepol.errors.SpacepolError` (one
-line naming what is wrong) where the command line exits with status 2. Nothing here changes a process-wide setting;
-:func:`spacepol.configure_process` opts in to the command line's speed settings.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -7,8 +7,7 @@ read noise is Gaussian; the full well clips; the ADC divides by the gain and tru
 parameters computed as if the analysers were ideal then hold S0 (T_max + T_min) and S1, S2 (T_max - T_min): the
 measured DoLP is the true one times (ER - 1) / (ER + 1), the extinction ratio's leakage.
 
-Settings come from TOML with units in the key names (``[camera]``), validated like the scenario: an unknown key,
-a wrong unit or an impossible value is one line naming it.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

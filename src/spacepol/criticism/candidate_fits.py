@@ -1,14 +1,7 @@
 """diagnose's fits of its candidate models: each built, searched and refitted on its own, in this process or in
 worker processes at once (``CandidateFits``), with the same answer either way.
 
-Processes, not threads: a candidate's work holds Python's global lock (two threads screening two candidates took as
-long as one after the other on PTFE), so only separate processes use a second core. Each task's seed comes from one
-draw of the caller's generator (at the first task) and the task's kind and model alone (``task_seed``), so the results
-do not depend on the number of workers, on the order tasks finish in, or on which other candidates were fitted
-before (a candidate left out or added changes no other candidate's fit). A worker receives the data once, builds each
-posterior itself (a compiled likelihood cannot be sent between processes) and sends back numbers and Results without
-their posterior, which the caller's own posterior replaces. Models with a plug-in effect from a file are fitted in this
-process (a fresh worker would not know the file).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

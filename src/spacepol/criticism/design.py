@@ -1,15 +1,6 @@
 """Experiment design: which further measurements would break a degeneracy the data leave.
 
-From a parameter point (the posterior median, or the optimum) the Fisher information of the data in hand
-(``infer.fisher``) plus the priors' precision gives the Laplace covariance of the free model parameters.
-In units of each prior's width its largest eigenvalue is the worst-measured combination: the *ridge*
-(for DOP alone, k_s and rho_d scaled together). Every candidate measurement (an observable at a geometry
-of a grid over the hemisphere, at an assumed noise) adds its own information; the candidates are ranked
-by how much they shrink the posterior sd along the ridge, picked greedily (each pick changes what the
-next one adds), and the result is said in words: "measure BRDF at theta_i 20, theta_r 0, dphi 180 ...
-shrinks the k_s-rho_d ridge 25x; DOP at any geometry at most 1.0x". The prediction is linear; whether
-the posterior really shrinks is measured by adding the measurements and inverting again
-(``tests/test_design.py``, ``benchmarks/design_shrink.py``).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,22 +1,6 @@
 """What is missing or wrong in a model: screen every change (add, replace, remove), confirm the leaders.
 
-1. Fit the model M and keep its pointwise PSIS-LOO (each fit: a Laplace approximation corrected by importance
-   sampling where its Pareto k trusts it, else emcee; ``fit_for_elpd``).
-2. Screening: for every change of M (``criticism.changes``: each registered effect added, each
-   slot member replaced by another of its slot, each removable effect removed; built-ins and
-   plug-ins alike), the maximum of the log posterior of the changed model near M's (``optimum.screen_optimum``:
-   a scan over the change's own parameters, local polishes, DE seeded with them); the gain over M's maximum (a
-   likelihood-ratio statistic) ranks the candidates.
-3. Confirmation: the ``top`` candidates get a global multistart too, and are refitted (as M) from the better of
-   the two optima; the change in ELPD-LOO and its
-   standard error come from the pointwise LOO differences; significant = gain > 2 SE and > 4. The best screened is
-   refitted first; a candidate whose log likelihood at its own optimum falls clearly below that refit's ELPD-LOO
-   (``_dominated``) could neither lead nor tie, and is not refitted.
-4. Twins: confirmed candidates whose pointwise LOO agree within noise are reported as tied; the
-   explanation says what measurement separates them (as the effects declare it). Effects declared
-   twins are always refitted together, except on data whose fitted observables separate them
-   (``Effect.separated_by``).
-5. A significant change whose residuals stay structured "helps, but does not explain the misfit".
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

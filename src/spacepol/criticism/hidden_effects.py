@@ -5,10 +5,7 @@ value), with a given noise level and angle sampling, runs :func:`diagnose` with 
 library, and scores: was E named (or reported as a twin of the verdict)?  does adding E bring
 the reduced chi^2 to the noise floor and recover E's own parameter in its 90 % interval?
 
-The *size* of a hidden effect is what the base model cannot absorb: the paper model is fitted
-(differential evolution) to the noise-free data, and the size is the RMS of that best fit's
-residuals in units of the noise, over every observation (DOP and BRDF). An effect that a shift
-of n or sigma mimics (e.g. in-plane anisotropy) has size ~0 on those data, whatever its value.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

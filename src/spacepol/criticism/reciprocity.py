@@ -1,16 +1,9 @@
 """Reciprocity (Helmholtz): swapping source and detector leaves a BRDF unchanged and transposes its
-Mueller matrix. Swapped, the source sits at the detector's azimuth, so dphi changes sign; in spacepol's
-frames (DESIGN.md, "Geometry convention")
+Mueller matrix, M(theta_r -> theta_i, -dphi) = Q M(theta_i -> theta_r, dphi)^T Q with Q = diag(1, 1, -1, 1) in
+spacepol's frames; how far a model or a measurement is from it, and the mirror asymmetry of pairs (dphi, -dphi)
+that an isotropic sample must measure equal.
 
-    M(theta_r -> theta_i, -dphi) = Q M(theta_i -> theta_r, dphi)^T Q,   Q = diag(1, 1, -1, 1),
-
-which SCATMECH's reciprocal facet model satisfies to rounding (tested), as do spacepol's reciprocal effects.
-(On an isotropic surface, mirror symmetry M(-dphi) = diag(1, 1, -1, -1) M(dphi) diag(1, 1, -1, -1) turns
-this into D M^T D at the same dphi, D = diag(1, 1, 1, -1); the form here needs no isotropy.)
-A model term that breaks it (the paper's cos(theta_r) body term, its shadowing function) cannot be the
-physics of a passive surface; measured data that break it beyond their noise point to an instrument
-or alignment error. Germer's PTFE set is reciprocal by construction of his measurement (Appl. Opt. 56,
-9333, 2017); here it is checked on the rows whose swapped geometry was also measured.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,23 +1,8 @@
-"""Detecting a point source in micro-polarizer frames at a fixed false-alarm rate.
+"""Detecting a point source in micro-polarizer frames at a fixed false-alarm rate: the matched filter (the
+likelihood-ratio test under Gaussian noise of the sky, dark current and read noise) per detector (intensity, Stokes,
+DoLP image), and its Neyman-Pearson curve P_d = Q(Q^-1(P_fa) - d), d the filter's output SNR.
 
-The target adds s_c(x) electrons to channel c (the analysers at 0, 45, 90, 135 deg) of the pixels x around its known
-position (its photon flux through the PSF and each analyser's transmission); the sky adds b_c electrons per pixel,
-the same everywhere in the stamp and known from the frames around it. With Gaussian noise of variance v_c = b_c +
-dark + read^2 per pixel (Poisson in the high-count regime) the likelihood-ratio test is a matched filter, and the
-Neyman-Pearson curve is P_d = Q(Q^-1(P_fa) - d) with d the deflection (the SNR of the filter's output):
-
-- ``intensity``: one filter on the channels' sum (what an intensity camera sees): d^2 = (sum s)^2 / sum v;
-- ``stokes``: the filter on every channel with its own noise (the four analysers jointly, i.e. the Stokes images):
-  d^2 = sum_c sum_x s_c(x)^2 / v_c. It gains where the sky is polarized (one analyser sees less of it) and the
-  target's polarization differs from the sky's;
-- ``dolp``: what a DoLP image shows: how far the degree of linear polarization of the PSF-weighted flux at the target
-  (sky and target together) lies from the sky's own DoLP. A target polarized unlike the sky, or a bright unpolarized
-  one diluting it, moves it. No closed form: its threshold comes from sky-only statistics and its P_d from frames
-  with the target (``dolp_statistic``, ``threshold_from_sky``, ``detection_probability``); over a pass,
-  ``dolp_detection_probability`` draws the four PSF-weighted channel fluxes directly, which for Gaussian pixel
-  noise have exactly the distribution full frames give them.
-
-``threshold_from_sky`` sets any detector's threshold from statistics on sky-only frames.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

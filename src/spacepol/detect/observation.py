@@ -6,16 +6,7 @@ the target through the PSF at places spread over a superpixel, the sky per pixel
 P_d at the fixed false-alarm rate (``detect.detection``: the matched filters' Neyman-Pearson curves, the DoLP
 image's by simulation; checked against simulated frames in tests/test_detection.py and tests/test_observation.py).
 
-The sky (stated model, the scenario may override its parts):
-- radiance: the CIE standard general sky, type 12 ("clear, low turbidity"; CIE S 011/E:2003, Kittler, Perez and
-  Darula), L(view) / L(zenith) = f(chi) phi(Z) / (f(Z_sun) phi(0)), with chi the view's angle from the sun and Z its
-  zenith angle; its zenith level from ``sky_magnitude_zenith`` (mag arcsec^-2 in the band; default 5.40, what the
-  paper's Table 3 implies) through the paper's zero point (eq 36). The CIE pattern is a visible-light luminance
-  distribution: in the near infrared, where aerosols scatter more evenly, it is an approximation.
-- polarization: single Rayleigh scattering scaled by P_max (``skylight.RayleighSky``), the E-vector perpendicular to
-  the sun - view plane.
-Atmospheric transmission of the target's light is the camera's ``transmittance``; the target's own extinction near
-the horizon and the sky's turbidity are not modelled further.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

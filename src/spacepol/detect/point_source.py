@@ -1,23 +1,8 @@
-"""A point source on a micro-polarizer sensor, pixel by pixel: what the detectors see of the target.
+"""A point source on a micro-polarizer sensor, pixel by pixel: the mean electrons of each pixel of a stamp
+around the target (the sky's plus a part linear in the target's linear Stokes photon flux, through the PSF and
+each analyser's transmission), and what the detectors see of it.
 
-On a stamp of the raw mosaic around the target, the mean electrons of pixel x are the sky's m0(x) plus a part linear
-in the target's linear Stokes photon flux s = (S0, S1, S2) at the aperture: B(x) . s, with
-
-    B(x) = QE t_exp A_eff psf(x) (T_max + T_min, (T_max - T_min) cos 2 theta(x), (T_max - T_min) sin 2 theta(x)) / 2,
-
-theta(x) the pixel's analyser angle and psf(x) the PSF's share on the pixel, centred where the target falls. The
-noise variance is m0(x) + read^2 (Poisson and read noise; the target's own shot noise is left out, the weak-signal
-regime that sets the detection limit). So every detector's figure is a quadratic or linear form in s
-(``PointSourceStamp``), exact for this sensor model and evaluated for all posterior draws at once:
-
-- intensity matched filter on superpixel sums (what an intensity camera of the same pixels sees):
-  d^2 = sum_X (C(X) . s)^2 / V(X), C and V summed over the superpixel X's four pixels;
-- Stokes matched filter on every pixel: d^2 = sum_x (B(x) . s)^2 / v(x);
-- the DoLP image at the target: the PSF-weighted flux of each analyser channel, F_c = sum_{x in c} psf(x) frame(x),
-  Gaussian with mean sum psf m0 + (sum psf B) . s and variance sum psf^2 v.
-
-Where the target falls within a superpixel changes all three (a PSF of two pixels is undersampled by the mosaic):
-``observe_pass`` averages P_d over positions spread evenly over one superpixel.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,18 +1,7 @@
-"""Photon budget and detection limit (paper eqs 34-39), with its units made explicit.
+"""Photon budget and detection limit (paper eqs 34-39), with its units made explicit, in two readings of the
+micro-polarizer (``reading``: the corrected one, and the paper's as printed).
 
-Two readings of the micro-polarizer (``reading``):
-
-* ``"paper"``: the target's light reaching a pixel is scaled by (1 + P)/2, the transmission of
-  one polarizer aligned with the target's angle of polarization (eq 34's (1 + P_s) with the
-  half folded into its prefactor; eq 36's (1 + P_B)/2 for the sky);
-* ``"corrected"``: the image is formed by 2 x 2 superpixels of polarizers at 0, 45, 90 and
-  135 deg; their mean transmission is exactly 1/2 whatever P and the AoP, so P does not change
-  the photon budget (it changes only what the four channels differ by).
-
-Eq 39 takes lambda in angstrom (1.44e8 is c_2 = hc/k_B = 1.4388e8 angstrom K) and the flux in
-photons cm^-2 s^-1; a flux per m^2 is divided by 1e4 first. Eq 34's prefactor 1.65 lacks a scale
-of about 1e20 photons m^-2 s^-1 (the in-band solar photon flux times the sphere's phase-function
-constant); ``sphere_flux`` takes it as an explicit argument.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

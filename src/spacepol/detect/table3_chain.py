@@ -1,19 +1,8 @@
-"""The paper's Table 3 limit through the pass chain's detector: its Table 2 instrument as a camera, its spot, its sky.
+"""The paper's Table 3 limit through the pass chain's detector: its Table 2 instrument as a camera, its spot, its
+sky; the target flux at which the intensity detector (a matched filter on superpixel sums) reaches the paper's
+required SNR, beside the paper's printed limit flux.
 
-``contrast`` takes the paper's printed limit flux Phi_s (8.472e5 photons m^-2 s^-1 through the polarizer) to a
-limiting magnitude (eq 39). The chain asks instead at which target flux its intensity detector (a matched filter on
-superpixel sums, ``detect.point_source``) reaches the paper's required SNR, for the same instrument:
-
-- the camera: aperture A_0 (1 - eps^2), transmittance tau_0 tau_s tau_p f_s, QE, t_s, N_R, N_D, pixel A_p; ideal
-  analysers, no full well (Table 2 gives none);
-- the sky: Phi_B at M_B per arcsec^2 through tau_0 tau_p f_B for t_B (no atmospheric tau_s, as in eq 36), its
-  superpixel mean as eq 36's N_B with the corrected reading's 1/2;
-- the spot: the target's light spread evenly over the k = ``spot_pixels`` pixels nearest the centre of a superpixel
-  (k = 4: one superpixel), as eq 35 spreads it.
-
-Three limits then stand side by side: the printed Phi_s (``contrast``), eq 38 solved for SNR (per-pixel SNR, the
-target's shot noise and N_D t_s k included), and the chain's matched filter (the k pixels' signals summed against
-their noise: sqrt(k) more SNR for the same light, the target's own shot noise left out, dark current per pixel).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -6,17 +6,7 @@ theta_r from range R, the Stokes flux at the aperture is
 
     F = E cos(theta_i) A cos(theta_r) / R^2 x S(theta_i, theta_r, dphi)     (W m^-2, and photons m^-2 s^-1)
 
-with S the first column of the material's Mueller BRDF (sr^-1; ``Prediction.stokes``). Each face's S is in its own
-basis (s = n x d normalised, d the direction to the observer: DESIGN.md's convention); the faces' Stokes vectors
-are rotated into one basis before they are summed: s_ref = u x d normalised, with u the site's geocentric vertical,
-so S1 > 0 is light polarized horizontally on the observer's sky and the AoP is measured from the horizontal
-towards the vertical. A face that is not lit (theta_i >= 90 deg, or the satellite in Earth's shadow) or not seen
-(theta_r >= 90 deg, or below the horizon) adds nothing; other faces' shadows and light reflected between faces are
-left out.
-
-The sun in the band: a 5772 K black body (IAU 2015 nominal solar effective temperature) of the sun's radius (695,700
-km) at 1 au. Across 1.0-2.0 um this is within a few per cent of measured solar spectra (e.g. ASTM E-490); the
-scenario may override the band irradiance.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

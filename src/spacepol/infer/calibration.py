@@ -6,9 +6,7 @@ truth is one more draw from it: its rank among L independent draws is uniform on
 probability p holds it in a fraction p of the replicates. A sampler that is too narrow piles the ranks at both ends
 (a U), one that is too wide piles them in the middle, a biased one tilts them.
 
-The data are DOP and BRDF (absolute and relative Gaussian noise, not clipped, so the likelihood is exact), or the
-normalised Mueller elements when ``mueller_noise`` is given. ``likelihood_noise_scale`` tells the likelihood the
-noise is that many times what it is: the negative control (1/3: a posterior 3x too narrow) must fail.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,14 +1,7 @@
 """When a chain run for one number, its ELPD-LOO, may stop before the posterior has converged: when the ELPD-LOO
 of its first and second halves agree.
 
-diagnose refits a changed model to compare predictive accuracy (delta ELPD-LOO, significant beyond 2 SE and 4); the
-walkers' R-hat and ESS targets ask for the whole posterior. On PTFE's oxide-layer ridge the chains stop at
-diagnose's 8,000-step cap unconverged, yet the ELPD-LOO of ``paper+lambertian+oxide_layer`` read at 2,000,
-4,000, 8,000 and 16,000 steps moved by at most 2 (``studies/emcee_cap_elpd.py``), while ``+ggx``'s moved by 44
-between readings (its walkers switch between two modes). A split-half check on the estimate itself tells the two
-apart: the halves of the kept chain are two stretches of time, so walkers that move between modes give halves that
-disagree. It cannot see a mode no walker has reached yet, and neither can a longer chain that never gets there;
-the refit is still reported as not converged (R-hat, ESS), with the step at which its ELPD-LOO settled.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

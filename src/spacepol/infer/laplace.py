@@ -1,51 +1,9 @@
-"""A posterior from its mode: a Gaussian (Laplace) approximation, corrected by Pareto-smoothed importance sampling.
+"""A posterior from its mode: a Gaussian (Laplace) approximation in the samplers' coordinates, corrected by
+Pareto-smoothed importance sampling (a Student-t proposal; an adapted mixture in the declared parameters where a
+parameter piles at a bound), trusted only where Pareto k <= 0.7 with 400 effective draws and the weights have not
+collapsed onto the mode; the caller's walkers' check (``spread_check``) guards what Pareto k cannot see.
 
-Where a model is compared with its neighbours (diagnose's refits), the question is each one's predictive
-accuracy (ELPD-LOO), and on thousands of numbers the posterior of a dozen parameters is close to a Gaussian
-around its mode. So:
-
-1. the mode in the sampling space z (``sampling_space``: the logit of each prior's CDF, where no bound is
-   left and the declared priors hold exactly), polished by L-BFGS from an optimum already found;
-2. the Hessian there by central differences of the batched log posterior (steps of half a posterior SD,
-   from a first pass on the diagonal);
-3. draws from a multivariate Student-t (5 degrees of freedom: tails heavier than the Gaussian's, so the
-   importance ratios stay bounded where the posterior is skewed) with that mode and covariance. On PTFE's
-   ``paper`` posterior (rho_d and a noise level piled at bounds) three seeds gave Pareto k 0.43-0.61 with 5
-   degrees of freedom, 0.66-0.78 with 7, 0.54-0.74 with 15;
-4. where a parameter piles at a bound of its prior (a dielectric's k at 0), its marginal in z has an exponential
-   tail towards the bound that no t at the mode matches, and curved correlations with the parameters it trades
-   against (k with k_s). Then the draws are made in the declared parameters instead, where such a posterior is
-   a Gaussian cut by the bound (draws outside the prior weigh 0): a t from the Laplace covariance carried over
-   by the delta method, adapted (up to eight times, until the weights are trusted) to the weighted draws' mean and
-   covariance, each adapted t mixed half and half with the proposals before it; where the last one's Pareto k is
-   <= 0.7 but its effective draws are short of 400, more draws from it (up to 10,000 in all: a volume-scattering
-   PTFE posterior, two phase-matrix parameters near a bound, needed 4,000-6,000; with three adaptations and 2,000
-   draws it gave k 0.55-0.77 and 80-110 effective draws, and emcee took ~90 s instead of ~2 s)
-   (population Monte Carlo with a defensive mixture: Cappe et al.,
-   J. Comput. Graph. Stat. 13, 907 (2004); Hesterberg, Technometrics 37, 185 (1995)). On the validation
-   suite's null set (k = 0 at the bound; 3 seeds) the t in z gave Pareto k 0.74-1.03 for ``paper`` and four
-   candidates; the adapted mixture 0.27-0.52 for ``+polarized_diffuse``, ``+lambertian`` and ``+extinction``,
-   0.19-0.70 for ``+dop_bias`` and 0.54-0.94 for ``paper`` itself (8 seeds; refused in half: emcee then).
-   ``tests/test_laplace.py`` checks it against emcee;
-5. importance weights log p | y - log q, Pareto-smoothed (PSIS, Vehtari et al., JMLR 25(72), 2024). Their
-   Pareto k says whether the approximation can be trusted at all (Yao et al., "Yes, but did it work?",
-   ICML 2018): accepted only where k <= 0.7 and the weights' effective sample size is at least 400 (emcee's
-   ESS target; ``ImportanceSample.reliable``);
-6. and only where the weights have not collapsed onto the mode: Pareto k sees the tail of the weights the draws
-   reached, not posterior mass the proposal never reached. On a curved ridge (PTFE's ``paper+lambertian+oxide_layer``
-   and its ``shadowing -> smith`` alternative at 0.633 um: n, k and the film thickness trade along it) the t at the
-   mode lands mostly off the ridge, a few draws on it take all the weight, and the adapted proposals, matched to
-   those few, shrink onto the mode: trusted by k (0.46-0.55) with SDs of n and k half the Laplace's in z, and half
-   of what emcee shows (n 2.08 +- 0.41 from walkers started inside the importance draws, which spread out). On
-   posteriors where the approximation holds (``paper``, ``paper+lambertian``, three seeds each) every coordinate's
-   weighted SD in z was 0.97-1.26 of the Laplace SD; on the collapsed ones n, k and the thickness were at 0.46-0.53.
-   So a coordinate narrower than ``MIN_WIDTH_RATIO`` (0.75) x its Laplace SD refuses the approximation (a posterior
-   flatter-topped than a Gaussian is refused too: emcee then, slower but right).
-Otherwise the caller samples with emcee (``inversion.invert_laplace`` returns None).
-
-PSIS-LOO from such draws takes the approximation into account (Magnusson et al., "Bayesian leave-one-out
-cross-validation for large data", ICML 2019; ``loo_approximate_posterior`` in the R package loo): observation
-i's log ratios are log p(z_s | y) - log q(z_s) - log p(y_i | z_s), smoothed per observation (``importance_loo``).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

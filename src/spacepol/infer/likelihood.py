@@ -6,11 +6,7 @@ errors or an inferred nuisance level (one per channel group, declared by the obs
 Student-t with ``robust=True``. The pointwise log-likelihood (one entry per channel and geometry, in
 the order of ``observables``) is kept for PSIS-LOO.
 
-The log-likelihood is one compiled JAX function of the parameter sets: the model's evaluation, the
-observables' predictions, residuals and densities fused, so no Mueller matrix or residual array of
-sets x geometries is written to memory when only the sum per set is wanted (``total``, what the samplers
-and optimizers call). On a large data set, whose calls take 16 sets at a time, the total is the pointwise
-program's sum instead: as fast there, and a model then compiles one likelihood program, not two.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -2,15 +2,7 @@
 the Mueller matrix and the BRDF from reciprocal pairs (source and detector swapped, where a passive sample gives
 M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q, Q = diag(1, 1, -1, 1), and the same BRDF).
 
-Each pair gives one difference per channel whose variance is twice the noise variance; the noise of a channel
-group (the nuisance parameter that holds it: ``sigma_m_lin``, ``sigma_brdf_rel``, ...) is estimated from all of
-its differences robustly, sigma = 1.4826 median|d| / sqrt(2), so that a few pairs spoiled by alignment (near
-the specular peak) do not inflate it. Its relative standard error is about 1.17 / sqrt(K) for K differences
-(the median absolute deviation's efficiency, 37 %, of the standard deviation's 1 / sqrt(2K)).
-
-How it is used (``infer.posterior``): the inferred noise level of the group may not fall below
-``MeasuredNoise.floor`` (the estimate less two standard errors), and every report compares the inferred level
-with the measured one: their ratio is the misfit the model hides in its noise.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

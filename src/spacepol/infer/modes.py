@@ -1,19 +1,6 @@
 """Where the sampler starts: independent searches for the posterior's maximum until they agree.
 
-One global search (``optimum.find_optimum_profiled``: differential evolution, the effects' branches, Sobol
-multistarts, on the posterior with its noise levels profiled out, then polished on the full posterior) can end in a
-local mode: on NIST's PTFE with four wavelengths the default seed's search (then without profiling) stopped ~6,000
-log units below the mode another seed found, and emcee, started there, reported a converged posterior of the wrong
-mode.
-So the searches are repeated with independent random streams until the best mode has been reached by
-``agreeing`` of them (at least ``min_searches`` searches, at most ``max_searches``). A better mode is missed only
-if none of the first ``min_searches`` searches finds it: with a chance p of one search finding it, (1 - p)^3
-(p = 0.6: 6 %, p = 0.87: 0.2 %; ``tests/test_modes.py``). The walkers start at the best, and every distinct mode
-found is kept with its log posterior, so a report can say how much worse the others are and whether two modes
-are close enough for the posterior to be multimodal.
-
-Two results are the same mode when their log posteriors differ by less than ``SAME_MODE_LOG_POSTERIOR``
-(a ridge, such as k_s and rho_d from DOP alone, is one mode however far apart its points lie).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,25 +1,6 @@
 """The maximum of the log posterior, found globally: where emcee starts and what screening compares.
 
-Three searches, the best (by the full posterior) wins:
-* differential evolution on the prior cube;
-* the branches the model's effects declare (``Effect.branches``): e.g. the dielectric k = 0 of
-  ``specular`` (PTFE, paints, glass) is a sliver of the cube under the default prior k ~ U(0, 20)
-  (k < 0.05 is 0.25 % of it) and DE converges on an absorbing optimum before it looks there, so a
-  second DE runs with k pinned at 0;
-* a multistart: 8192 scrambled Sobol points, the best 8 polished by L-BFGS-B with batched finite
-  differences (exact JAX gradients are an option: 1.3x faster on PTFE, slower on small sets, and a polish
-  that reaches a dielectric's k = 0 stops there, where the gradient in k is exactly 0). Thin films make the
-  posterior a comb of interference orders in which DE settles on a wrong tooth (a film hidden
-  at 0.25 um: DE -443, multistart +845 in log posterior, the truth +841).
-DE stays: it is the cheapest of the three (0.04 s on 84 points) and on the ridge sets it finds the optimum
-every time; the multistart is what finds films and PTFE's optimum (``benchmarks/optimum_speed.py``).
-
-Where the sampler starts (``find_optimum_profiled``, run by ``modes.search_modes``), the same searches climb the
-posterior with its noise levels profiled out (``profiled``), a multistart runs on each branch too, and every
-search's optimum is polished on the full posterior. On PTFE at four wavelengths (``paper+polarized_diffuse``) no
-plain search of 9 reached the best mode and 6-8 of 9 profiled ones do (``benchmarks/start_search_modes.py``,
-docs/benchmarks-log.md). Profiling alone is not what finds it: the cube's profiled optimum is a mode ~6,000 log
-units lower, and only the dielectric branch's multistart, polished in full, leaves it.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

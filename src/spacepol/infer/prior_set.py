@@ -7,21 +7,7 @@ Defaults come from each effect's ``Parameter``; a TOML file overrides them::
     lower = 1.0
     upper = 2.0
 
-    [k]
-    fixed = 0.0              # hold at a value
-
-    [sigma_p]                # free a parameter that is fixed by default
-    distribution = "uniform"
-    lower = 0.0
-    upper = 0.1
-
-    ["n@0.633"]              # a refractiveindex.info table (data/nk/ or a path): normal at its value
-    nk_table = "main_Al_nk_Rakic.yml"
-    relative_sigma = 0.05    # (plain n, k need wavelength_um = ...)
-
-The parameter vector ``theta`` (shape (W, D)) lists the free parameters in model order; the
-unit cube u in [0, 1]^D maps to theta through each prior's inverse CDF (``rescale``), so the
-GA, nlopt and differential evolution search the very space the sampler sees.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

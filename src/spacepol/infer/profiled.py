@@ -7,8 +7,7 @@ model with a wrong noise level as often as a bad one with the right level, and o
 wavelengths, ``paper+polarized_diffuse``) 7 of 9 searches ended on the plateau where the specular term is off
 and every Mueller element's noise is the RMS of the data, or in a mode ~5,000 log units below the best.
 
-The levels' priors are left out of the profiled value (they are uniform by default, and the full posterior is
-polished from the profiled optimum anyway: ``complete`` gives the full parameter vector to start from).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

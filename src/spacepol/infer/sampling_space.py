@@ -6,23 +6,7 @@ In z every declared prior becomes exactly the standard logistic density, so
 
     log p(z | data) = log L(theta(z)) + sum_j [log sigmoid(z_j) + log sigmoid(-z_j)]
 
-(the Jacobian |d theta / d z| times the prior density is that logistic density): the priors stay as
-declared, and there are no bounds to step over.
-
-Why: the degeneracies the physics creates are multiplicative. DOP sees k_s / rho_d, not each (scaling
-both leaves DOP unchanged), so with uniform priors the posterior is a wedge from the origin of the
-(k_s, rho_d) plane, 100x narrower near zero than near the top, which no fixed proposal scale crosses
-quickly. Near a lower bound z is log(theta - lower), so the wedge becomes a straight band of constant
-width (log k_s - log rho_d = const): emcee's affine-invariant moves and NUTS's dense mass matrix both
-follow a straight band, whatever its direction (``benchmarks/inversion_speed.py``: tau 81-99 -> ~30
-steps on the 84-point DOP set). Any other linear ridge the Fisher analysis finds is handled the same way.
-
-Except: a parameter whose posterior reaches a bound of its prior with a density that does not vanish there
-(a dielectric's k near 0) stays in its declared coordinates (``reaching_a_bound``). There the logit would
-turn the pile-up against the bound into an exponential tail to z = -inf, curved against n: four such k's (a
-four-wavelength dielectric, tests/test_spectral.py) made tau 122 and the chain 12,000 steps, still short of
-R-hat 1.01; with those four k's declared tau was 60 and it converged at 6,500 steps (declared throughout:
-tau 64, 7,000 steps).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

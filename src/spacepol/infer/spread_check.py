@@ -1,16 +1,6 @@
 """Whether importance draws hold the posterior's whole width: emcee walkers started inside them, left to spread.
 
-Pareto k and the effective draws judge the weights on the draws the proposal reached; they cannot see posterior mass
-it never reached. On a curved band (DOP-only data, k_s against rho_d; PTFE's n-k-thickness ridge) a proposal
-matched to the few draws near the mode is trusted by k and gives SDs 0.6-0.9 of the truth. A Markov chain that keeps
-the posterior does not care where it starts: walkers started from the weighted draws stay as wide as they are where
-the draws are the posterior, and spread where the draws are too narrow. So the check runs emcee's ensemble (the
-same differential-evolution moves as the ``emcee`` engine, in the same logit-CDF coordinates) for ``STEPS`` steps from
-resampled draws and compares, per declared parameter, the SD of the second half of that run with the draws' weighted
-SD. A ratio above ``MAX_SD_GROWTH`` refuses the draws (the caller samples with emcee instead).
-
-The run is short and its SDs carry Monte-Carlo error (``SpreadCheck.standard_error``, from batch means over the
-kept steps); a refusal where the draws were right costs time, never a wrong answer.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,18 +1,6 @@
 """What an observable is: a measured quantity the likelihood compares with the model.
 
-An observable has one or more *channels*, each a vector over the N measured geometries (DOP has one,
-the normalised Stokes parameters two, q and u, the normalised Mueller matrix fifteen, m12 ... m44).
-It says from the model's output what each channel predicts, how a residual is formed, how the noise is
-modelled (the file's errors per row, or one inferred noise level for its channel group), its log
-density, how replicate data are drawn and its ArviZ dimensions. The likelihood, the residual analysis,
-the figures and the InferenceData use channels generically. It also says how it is read: the file columns it
-comes from (``columns``, ``optional_columns``, ``error_columns``), their checks, and the arrays the
-:class:`~spacepol.io.dataset.Dataset` keeps (``arrays``, rows on the last axis). Adding an observable is one new
-file in this package (found by the registry in ``observables/__init__.py``), an entry point of the group
-``spacepol.observables`` or a user's file (``--observables path/to/file.py:Name``).
-
-``predict``, ``residual`` and ``log_density`` also run inside the compiled likelihood, on JAX arrays:
-they compute with ``array_module(...)`` (numpy for numpy arrays, jax.numpy for JAX ones).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -7,23 +7,7 @@ over all rows of a data set for a Model or a SpectralModel (one part per wavelen
 compile more around it (the likelihood). Parameter sets are padded to ``bucket`` sizes so the walkers,
 batches and remainders of an inversion do not each compile a program.
 
-Three rules keep XLA fast on a CPU: terms that depend on the geometry alone are computed outside
-(``Geometry.device_terms``) or held behind a barrier (``once``), since XLA otherwise fuses them into every
-(parameter set, geometry) element that uses them and recomputes their trigonometry there; a Stokes vector
-or Mueller matrix is assembled by broadcasting each parameter-dependent value over geometry-only bases
-(``fresnel.combined``, ``Geometry.mueller_basis``), never stacked element by element: stacked, XLA computes the
-value (a Fresnel coefficient, the facet distribution's exp) again in each of the 16 elements (measured:
-paper+polarized_diffuse's Mueller matrix 7 -> 28 M evaluations/s); and the additive lobes are added as whole
-arrays (a depolarized one through a one-hot pattern), not written into one in place (an in-place update made
-XLA copy all 16 elements out again for the likelihood).
-
-A program that needs the total only up to a positive factor per element (the DOP alone, the likelihood of
-DOP, AoP or normalised Stokes data: ``up_to_scale``) does less: the specular lobe keeps its Fresnel
-denominator aside (``effect.Ratio``), so the paper's DOP costs 2 square roots, 1 division and an exp per
-element instead of 3, 5 and 1 (the lobe's polarized part is known in closed form, ``Ratio.polarized``, so the
-DOP's own root goes too), and the Stokes vector stays four separate rows: a value broadcast over the
-Stokes axis is one that XLA will not fuse with its expensive producers (it computes them in loops of their
-own and stores them), while the rows let the whole DOP run as one loop.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -6,21 +6,7 @@ scattering plane's (parallel, perpendicular) basis,
 
     [[1, b1, 0, 0], [b1, a2, 0, 0], [0, 0, a3, b2], [0, 0, -b2, a4]]
 
-(NIST's 1-based names: b1 = m12, a2 = m22, a3 = m33, a4 = m44, b2 = m34). Each element is SCATMECH's cubic spline
-through its values at 0, 60, 120 and 180 deg, with zero slope at both ends; symmetry fixes b1 = b2 = 0 at 0 and
-180 deg, a3 = a2 at 0 deg and a3 = -a2 at 180 deg. The 14 values left are SCATMECH's parameters.
-
-Realizability: the Cloude coherency matrix of this form has the eigenvalues (sympy, ``tests/test_phase_matrix.py``)
-
-    (1 - a2 - a3 + a4) / 4,  (1 - a2 + a3 - a4) / 4,  (1 + a2 -+ |(a3 + a4, 2 b1, 2 b2)|) / 4,
-
-so the set K of realizable reduced matrices is convex: |a3 - a4| <= 1 - a2 and |(a3 + a4, 2 b1, 2 b2)| <= 1 + a2.
-Every node is put inside K by a triangular map of box coordinates in [-1, 1] (``node_values``). Between the nodes
-a spline can leave K, so the nodes are then drawn radially towards the depolarizer diag(1, 0, 0, 0) (the centre of
-K, all eigenvalues 1/4) until every Bezier control point of the spline's three cubic pieces lies in K: the spline
-lies in the convex hull of its control points, so it is realizable at every angle, exactly. The pull acts only
-in the outer shell of the box (a node set closer to the depolarizer than 0.8 of the way to where the spline would
-first leave K is kept as it is), and it is one-to-one, so every point of the box gives a distinct realizable matrix.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,34 +1,9 @@
-"""The Effect interface: one physical ingredient of the pBRDF, composable with ``+``.
+"""The Effect interface: one physical ingredient of the pBRDF, composable with ``+``. An effect declares the
+parameters it owns, the effects it needs or excludes, what model criticism needs to know about it (slot, twins,
+neutral values, ...), and takes part in the evaluation through hooks (geometry, configuration, the specular
+factor and lobe, an additive lobe, the total Stokes vector or Mueller matrix, the measured DOP).
 
-An effect declares the parameters it owns (names must be unique across a model, as in lmfit),
-the effects whose parameters or lobe it uses (``requires``), and the effects it cannot be
-combined with (``excludes``).  It takes part in the evaluation through any of these hooks, called in
-this order for every effect of the model:
-
-1. ``transform_geometry(params, geometry)``: e.g. a goniometer zero offset;
-2. ``configure(ctx)``: choose the facet distribution, widths or Fresnel coefficients;
-3. ``specular_factor(ctx)``: a multiplicative factor of the specular lobe (shadowing);
-4. ``modify_specular(ctx, lobe)``: change the specular lobe (e.g. depolarize part of it);
-5. ``lobe(ctx)``: an additive lobe (body scattering, subsurface light);
-6. ``modify_stokes(ctx, total)``: the instrument seen on the total (analyser extinction);
-7. ``modify_dop(ctx, dop)``: the estimator of the measured DOP (noise bias).
-
-Lobes are arrays of shape (4, *shape) (the Stokes vector for unpolarized incidence) or
-(4, 4, *shape) (the Mueller matrix, when the caller asks for it): row operations such as
-``lobe.at[1:].multiply(f)`` work on both.  ``lobe`` may also return ``ctx.depolarized(f)``, a lobe that
-only scatters intensity (stored as its S0 alone).
-
-A program whose outputs do not change when every (set, geometry) element of the total is multiplied by a
-positive number (DOP, normalised Stokes parameters: ``ctx.up_to_scale``) lets the specular lobe keep its
-Fresnel denominator (a ``Ratio``) and multiplies the other lobes by it instead of dividing; hooks never see
-a Ratio (an effect that overrides ``modify_specular`` or ``modify_stokes`` gets the divided value).
-
-**Hooks are JAX code.** The model is compiled with ``jax.jit`` and evaluated for many parameter sets at
-once, so a hook computes with ``jax.numpy`` (``import jax.numpy as jnp``) and returns new arrays: JAX
-arrays are immutable (``lobe[1:] *= f`` becomes ``lobe = lobe.at[1:].multiply(f)``), and parameters are
-traced values (no ``float(x)``, no ``if x > 0:`` on them; use ``jnp.where``). An effect that cannot be
-traced (numpy on traced values, in-place updates, Python branches on parameters) stops the evaluation
-with one EffectError naming it.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

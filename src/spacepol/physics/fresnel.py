@@ -1,19 +1,8 @@
-"""Fresnel reflection at a facet for a complex index N = n + ik (time dependence exp(-i w t)).
+"""Fresnel reflection at a facet for a complex index N = n + ik (time dependence exp(-i w t)): power
+reflectances, complex amplitudes and the Mueller matrix of reflection, in three forms checked against each other
+and against ``tmm``; transmission, and the interface's hemispherical internal reflectance.
 
-Three forms, checked against each other and against ``tmm``:
-
-* ``amplitudes``: complex r_s, r_p (thin films; ``matrix_entries`` turns them into the Mueller matrix).
-  Convention: the Stokes basis of each beam is (s, p, d) right-handed with the same s for the
-  incident and reflected beam, so at normal incidence r_s = -r_p (a mirror).
-* ``power``: the real power reflectances R_s, R_p of paper eqs 14-19 with the corrected eq 15
-  (``sin(beta) tan(beta)``; ERRATA.md).  Cheaper: it is what DOP and BRDF need for unpolarized
-  incidence, so it is the hot path of an inversion.
-* ``interface_matrix_entries``: the Mueller matrix's entries of a bare interface in real arithmetic (the
-  full-Mueller hot path: complex arithmetic is ~3x slower compiled on a CPU).
-
-``power_paper_eq15`` keeps the printed (wrong) eq 15 so a test can show what the typo does.
-
-Written with ``jax.numpy`` (the forward model is compiled by JAX); numpy inputs work too.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -6,15 +6,7 @@ dphi = 180 deg is the specular (forward) plane.  Stokes vectors of each beam are
 the basis (s, p, d), right-handed, with d the propagation direction and s perpendicular to the
 macroscopic plane of incidence (or scattering): S1 > 0 is s-polarized light.
 
-Working with vectors instead of eqs 4-5 gives the sign of eta (which arccos loses) and exact
-limits at normal incidence and at the specular direction for free: the macroscopic s vector is
-defined from the azimuth alone, and where the half vector is parallel to a beam any facet s
-vector will do, provided the same one serves both beams.
-
-A ``Geometry`` holds every term that does not depend on the material parameters. Built from numpy
-angles it is numpy (reports, criticism, the data's own geometry); built from JAX arrays (inside the
-compiled forward model, or when an effect such as ``angle_offset`` moves the angles per parameter set)
-the same code computes it with ``jax.numpy``.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,14 +1,9 @@
 """The ``phase_matrix`` effect: light scattered once inside a porous material, with a free-form Mueller phase
-matrix that is physically realizable over its whole prior (``constrained_phase``), after NIST SCATMECH's
-``First_Diffuse_BRDF_Model`` with ``Constrained_Phase_Function`` (Germer, Proc. SPIE 10655, 1065504 (2018)):
+matrix that is physically realizable over its whole prior (``constrained_phase``), under an interface of its own
+index, with linear and circular depolarization along the paths; after NIST SCATMECH's ``First_Diffuse_BRDF_Model``
+with ``Constrained_Phase_Function`` (Germer, Proc. SPIE 10655, 1065504 (2018)).
 
-    M = w / (n'^2 (mu_i' + mu_r')) D_out T(theta_r) R_out HG(g; Theta) P(Theta) R_in T(theta_i) D_in,
-
-with n' the interface's own (real) index, which may differ from the facets' (a sintered powder's effective
-surface index lies between 1 and its grains'), mu' the internal cosines, P the reduced phase matrix splined
-between its values at 0, 60, 120 and 180 deg of internal scattering angle Theta, HG the Henyey-Greenstein phase
-function of asymmetry g, w the single-scattering albedo, and D the linear and circular depolarization along the
-way in and out (SCATMECH's depoll, depolc), shared between the paths by their lengths.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -6,10 +6,7 @@
     tan t_rp = tan(t_r) (sin t_r + sin t_i cos phi_r) / (2 sin(alpha) cos(beta))
     tan b_p  = |cos t_i - cos t_r| / (2 sin(alpha) cos(beta))            (corrected)
 
-2 sin(alpha) cos(beta) is the length of the horizontal part of k_i + k_r, so the two projected
-tangents are tan(theta) times the cosine of the angle between each beam's azimuth and the
-facet normal's azimuth.  At alpha = 0 (exact specular) those ratios are 0/0; we use the limit
-along the plane of incidence, where cos = +-1 and tan b_p -> tan(theta_i).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

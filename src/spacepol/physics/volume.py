@@ -1,20 +1,9 @@
 """Light scattered once inside the material, under a smooth interface: the effects ``volume`` (Code-Whitney
-phase matrix over a Henyey-Greenstein phase function) and ``volume_rayleigh`` (the Rayleigh phase matrix).
+phase matrix over a Henyey-Greenstein phase function) and ``volume_rayleigh`` (the Rayleigh phase matrix), after
+NIST SCATMECH's ``First_Diffuse_BRDF_Model`` (Germer, Proc. SPIE 10655, 1065504 (2018)): Fresnel transmission in,
+one scattering with a polarized phase matrix in the scattering plane's basis, transmission out.
 
-The physics is NIST SCATMECH's ``First_Diffuse_BRDF_Model`` (Germer, Proc. SPIE 10655, 1065504 (2018)):
-light refracts in through the interface (Fresnel transmission Mueller matrix T(theta_i) of N = n + ik, times
-the power factor n cos(theta_i') / cos(theta_i)), scatters once with a polarized phase matrix P(Theta) that is
-defined in the scattering plane's basis (parallel, perpendicular), and refracts out (T(theta_r)):
-
-    M = w / (n^2 (mu_i' + mu_r')) T(theta_r) R_out P(Theta) R_in T(theta_i),
-
-mu' the cosines of the internal (refracted) directions, Theta the internal scattering angle, R the rotations
-between each beam's (s, p) basis and the scattering plane's, and w the single-scattering albedo (scattering
-over attenuation, the host's absorption included). The factor 1/(mu_i' + mu_r') is the probability that light
-scattered at depth leaves unattenuated, integrated over depth. Everything is reciprocal.
-
-Both effects fill the slot ``volume``, so diagnose can swap one for the other; they add to any diffuse body
-term (``subsurface`` is the multiple scattering under the same interface).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

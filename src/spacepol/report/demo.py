@@ -1,17 +1,6 @@
 """``invert-mcmc demo``: the chain on bundled data, report in one folder.
 
-1. Forward model on the geometry of NIST's measured PTFE Mueller BRDF (0.633 um, plane of
-   incidence): ``ptfe_forward.csv``, ``ptfe_dop.png``.
-2. Bayesian inversion of that measurement (the 15 normalised Mueller elements and the BRDF) with the
-   paper's model, compared with PTFE's known bulk index (about 1.35): ``ptfe_paper/``.
-3. Model criticism on a bundled synthetic set with a hidden effect: fit -> diagnose -> ladder
-   (``hidden/``), then the hidden truth revealed.
-4. The same on PTFE (``ptfe_diagnose/``, ``ptfe_ladder/``): which effects improve ELPD-LOO by
-   more than 2 SE, and the error falling as they are added.
-5. The PTFE posterior against the daytime sky: Table 3 as distributions (``contrast/``).
-6. A target of that material on a real daytime pass (the bundled ISS elements over the paper's site): light curves
-   and P_d(t) per detector (``observe/``).
-7. ``report.html`` links them and says what was found.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

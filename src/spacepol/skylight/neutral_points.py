@@ -6,15 +6,7 @@ vertical: Babinet (above the sun) and Brewster (below), Arago (above the anti-su
 fourth below it. In the stereographic plane zeta = tan(theta/2) exp(i(90 deg - phi)) (x east,
 y north) the Rayleigh pattern is
 
-    w_R(zeta) = -4 (zeta b_S - a_S)^2 (zeta b_A - a_A)^2 / (1 + |zeta|^2)^2 x phase,
-
-with (a, b) = (sin(theta_k/2) e^{i(90 deg - phi_k)}, cos(theta_k/2)) for each point k: |w_R| =
-sin^2(gamma) exactly and arg(w_R) = 2 x (E-vector direction). BDL replace each squared factor by
-the product over the two split points, separated by +-delta along the vertical. The line pattern
-(the AoP) is their result; for the degree this module keeps the Rayleigh relation
-DOP = P_max |w| / (2 - |w|) (which is sin^2 / (1 + cos^2) when delta = 0). BDL's extra
-depolarization near the horizon is not included: the degree is a sketch, the zeros and the AoP
-pattern are the point.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

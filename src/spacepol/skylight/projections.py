@@ -7,12 +7,7 @@ follows from r alone: the scale along the meridian h = dr/dtheta and along the p
 k = r / sin(theta); the areal scale is h k and the maximum angular distortion
 omega = 2 arcsin(|h - k| / (h + k)).
 
-* stereographic: r = 2 tan(theta/2), the paper's "complex spherical" projection (eq 33,
-  x + iy = 2 r tan(theta/2) e^{i phi} on a sphere of radius r = 1); conformal (omega = 0), the
-  horizon drawn at twice its true scale;
-* orthographic: r = sin(theta), the paper's "direct vertical" projection; neither conformal nor
-  equal-area, the horizon crushed to zero radial scale;
-* Lambert azimuthal equal-area: r = 2 sin(theta/2); areal scale 1 everywhere.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

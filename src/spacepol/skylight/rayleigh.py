@@ -7,8 +7,7 @@ meridian (``directions.angle_of_polarization``). P_max = 1 is the ideal; a clear
 0.7-0.8 because of multiple scattering, aerosols and ground reflection, which also create neutral
 points that this model lacks (see ``neutral_points``).
 
-The paper's own forms are kept for comparison: eq 27 (theta = altitude) and eq 30 (theta =
-zenith angle; with altitudes it is wrong, ERRATA).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,30 +1,6 @@
 """emcee with a vectorised log-probability, ridge-friendly moves, automatic length and resuming.
 
-* Walkers start in a small ball around a quick differential-evolution optimum of the log
-  posterior (inside the prior support), not scattered over the prior (``initial="prior"``
-  does that, or pass an array).
-* Space: the walkers move in the logit of each prior's CDF (``infer.sampling_space``), where the
-  declared priors are kept exactly and the wedge DOP leaves between k_s and rho_d is a straight band,
-  except parameters whose posterior reaches a prior bound (a dielectric's k near 0); the chain file holds those
-  coordinates (and says which), the EngineResult the declared parameters. On the 84-point DOP set tau fell from
-  81-99 to ~30 steps (``benchmarks/inversion_speed.py``).
-* Moves: differential evolution (80 %) and DE snooker (20 %): DE moves follow the long ridges that
-  DOP-only data leave (k_s against rho_d); the snooker keeps a walker from staying stuck on one. The snooker
-  is ``snooker.DESnookerMove`` (emcee's own does not keep the posterior). Steps to convergence, three seeds of
-  the 84-point ridge set: DE + snooker 3,500-6,500; DE alone 6,000-7,000 and one seed stuck at the 30,000-step
-  cap (R-hat 1.09). Where no ridge is (PTFE at 0.633 um, a four-wavelength Cauchy set) DE alone needed
-  0.75-0.9x the steps.
-* Length: the chain grows in blocks of ``check_every`` steps (at absolute multiples, so a
-  resumed run makes the same decisions) until it is longer than ``tau_multiple`` times the
-  largest integrated autocorrelation time and that estimate has settled (changed < 5 % over
-  the last block; 1 % is emcee's suggestion but the estimate's own noise is larger), or until
-  ``max_steps`` (then ``info["capped"]`` is True and the report says so); it must then also
-  pass ArviZ's rank-normalised split R-hat <= ``rhat_target`` and bulk/tail ESS >=
-  ``ess_target`` (walkers as chains) on the kept draws.
-* Resuming: with ``backend_path`` the chain lives in an HDF5 file (emcee's HDFBackend, which
-  also stores the random state; written every 100 steps, ``buffered_backend``); a re-run continues it
-  and gives the chain an uninterrupted run would have given.
-* Randomness: emcee draws from a RandomState seeded from the Generator passed in.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

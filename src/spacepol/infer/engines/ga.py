@@ -1,16 +1,6 @@
 """The paper's genetic algorithm (section 2.3), as printed, with the ERRATA's readings.
 
-* Binary coding, n bits per parameter, b = round((2^n - 1)(a - a_min)/(a_max - a_min)) (eq 24,
-  b rounded); here a is the parameter's prior-cube coordinate, so with uniform priors this is
-  exactly the paper's coding of [a_min, a_max].
-* Population 100 of random chromosomes; fitness eq 25, a relative squared error **minimised**.
-* Selection: the 100 - N best survive and N are replaced by copies of random survivors
-  (the paper's "100 - N individuals"; N = ``n_replace``, our reading, default 20).
-* Crossover with probability 0.02 per random pair, single-point, multi-point (two-point) or
-  uniform, chosen at random; mutation with probability 0.02 per gene: uniform (re-draw),
-  boundary (min or max) or basic-position (one bit flipped), chosen at random.
-* The best chromosome is carried over unchanged (elitism; the paper's selection keeps it).
-* Stop when |best - mean fitness| < 1e-3 or after 100 generations.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -4,11 +4,7 @@ Chosen over dynesty by measurement (``benchmarks/nested_choice.py``, figures in 
 posterior nautilus gave more effective draws per second, evaluating the likelihood in the batches the compiled
 likelihood is built for.
 
-nautilus reports no error for ln Z, and the sampling error within its shells is smaller than the scatter of ln Z
-between seeds (the shells' volumes are estimated too). So the engine runs ``replicates``
-independent searches (seeds from the Generator) and reports ln Z as the log of their mean evidence with the
-standard error of the mean from their scatter. Each replicate's weighted points are resampled into one chain of
-about its effective size, so R-hat between replicates checks that they found the same posterior.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,17 +1,6 @@
 """NUTS (numpyro) on the compiled, differentiable likelihood: a gradient sampler beside emcee.
 
-* Space: the logit of each prior's CDF (``infer.sampling_space``), as for emcee: the declared priors
-  kept exactly (their density is the logistic in z), no bounds, the k_s/rho_d wedge a straight band.
-  Every parameter, unlike emcee's space: a parameter kept in its declared coordinates puts a wall at its
-  bound, and NUTS diverges on it (prior-only, sigma declared: 3,859 divergent of 4,000 draws); the curved
-  exponential tail the logit makes of a pile-up at a bound, which slows emcee, is smooth for NUTS.
-* Mass matrix: dense, adapted in warm-up (a linear ridge then costs nothing).
-* Chains: ``chains`` independent chains (4: R-hat needs several), vectorised into one compiled program
-  (one CPU device; numpyro's ``vectorized`` method), started in a small ball around the optimum.
-* Length: ``warmup`` adaptation steps, then draws in blocks of ``draws`` until ArviZ's rank-normalised
-  split R-hat <= ``rhat_target`` and bulk/tail ESS >= ``ess_target``, or ``max_draws`` (then
-  ``info["capped"]``). ``info`` gives leapfrog steps per draw and divergences: the honest cost measure.
-* Randomness: the JAX key comes from the Generator passed in.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

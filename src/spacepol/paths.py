@@ -1,4 +1,5 @@
-"""Where the bundled data lives (the repository's top-level ``data/`` folder)."""
+"""Where the bundled data lives: the package's ``data`` folder (the repository's top-level ``data/``, linked into the
+package so that an installed wheel carries it)."""
 
 from __future__ import annotations
 
@@ -7,11 +8,12 @@ from pathlib import Path
 
 
 def data_dir() -> Path:
-    """The bundled data folder: ``$SPACEPOL_DATA`` or ``data/`` beside ``src/``."""
+    """The bundled data folder: ``$SPACEPOL_DATA``, else the package's own ``data`` (found through the package's
+    location, so an installed wheel and a source checkout alike)."""
     env = os.environ.get("SPACEPOL_DATA")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / "data"
+    return Path(__file__).resolve().parent / "data"
 
 
 def bundled(*parts: str) -> Path:

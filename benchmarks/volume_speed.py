@@ -51,7 +51,7 @@ def main() -> None:
     c = CASE
     values = {"n": c["n"], "k": c["k"], "sigma": 0.2, "ks": 0.0, "w_vol": _albedo(c["la"], c["k"]), "g_vol": c["g"],
               "pl_vol": c["pl"], "pc_vol": c["pc"], "s_vol": c["s"], "dl_vol": 0.0, "dc_vol": 0.0, "rho_s": 0.5}
-    from spacepol.physics.phase_matrix import PhaseMatrix
+    from spacepol.physics.effects.phase_matrix import PhaseMatrix
 
     rng = np.random.default_rng(0)
     phase = {p.name: rng.uniform(*p.prior.bounds) for p in PhaseMatrix.parameters}

@@ -12,7 +12,7 @@ from scipy import stats
 from spacepol.criticism.hidden_effects import HIDDEN_VALUES, Case, effect_size, run_suite, suite, summarise
 from spacepol.criticism.changes import changes
 from spacepol.physics import Model
-from spacepol.physics.builtin_effects import BUILTIN_EFFECTS
+from spacepol.physics.registry import BUILTIN_EFFECTS
 
 
 def test_suite_covers_every_composable_builtin_effect_and_null_sets():

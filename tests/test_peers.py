@@ -10,7 +10,7 @@ import pytest
 
 from spacepol.physics import Geometry, Model
 from spacepol.physics import facets
-from spacepol.physics.builtin_effects import Smith
+from spacepol.physics.effects.smith import Smith
 from spacepol.physics.fresnel import hemispherical_internal_reflectance
 from internal_reflectance import scatmech_grid, walton
 

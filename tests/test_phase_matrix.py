@@ -13,7 +13,7 @@ from coherency import coherency_eigenvalues
 from spacepol.criticism.reciprocity import reciprocal_image, swapped
 from spacepol.errors import ParameterError
 from spacepol.physics import Geometry, Model, constrained_phase
-from spacepol.physics.phase_matrix import SHAPE_NAMES, PhaseMatrix, circular_depolarization
+from spacepol.physics.effects.phase_matrix import SHAPE_NAMES, PhaseMatrix, circular_depolarization
 
 pytest.importorskip("pySCATMECH")
 

@@ -18,7 +18,7 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "user_effects.py"
 
 def test_file_plugin_composes_by_name():
     reg = Registry()
-    for cls in __import__("spacepol.physics.builtin_effects", fromlist=["x"]).BUILTIN_EFFECTS:
+    for cls in __import__("spacepol.physics.registry", fromlist=["x"]).BUILTIN_EFFECTS:
         reg.register(cls)
     surge = reg.load_file(f"{EXAMPLE}:OppositionSurge")
     assert reg.get("opposition_surge") is surge

@@ -14,7 +14,7 @@ from spacepol.criticism.reciprocity import reciprocal_image, swapped
 from spacepol.io import Dataset, read_measurements
 from spacepol.paths import bundled
 from spacepol.physics import Geometry, Model
-from spacepol.physics.polarization_memory import PolarizationMemory
+from spacepol.physics.effects.polarization_memory import PolarizationMemory
 
 MEMORY = Model.from_string("specular+polarization_memory")
 

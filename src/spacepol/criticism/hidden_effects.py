@@ -22,7 +22,7 @@ from ..infer.posterior import Posterior
 from ..io.measurements import Dataset
 from ..physics.geometry import Geometry, default_grid
 from ..physics.model import Model
-from ..physics.registry import registry
+from ..physics.registry import BUILTIN_EFFECTS, registry
 from .diagnose import diagnose
 
 BASE = "paper"
@@ -30,24 +30,8 @@ MATERIALS = {  # two base materials the cases alternate between
     "paint": {"n": 1.5, "k": 0.0, "sigma": 0.25, "ks": 0.6, "rho_d": 0.3},
     "oxidised metal": {"n": 1.8, "k": 1.2, "sigma": 0.15, "ks": 0.8, "rho_d": 0.1},
 }
-HIDDEN_VALUES = {  # per built-in effect: a small and a large value, inside the default priors
-    "polarized_diffuse": [{"rho_pd": 0.05}, {"rho_pd": 0.3}],
-    "depolarization": [{"d_spec": 0.2}, {"d_spec": 0.6}],
-    "anisotropy": [{"sigma_x": 0.12, "sigma_y": 0.3, "psi": 30.0}, {"sigma_x": 0.08, "sigma_y": 0.4, "psi": 60.0}],
-    "ggx": [{}, {}],
-    "angle_offset": [{"delta_deg": 1.0}, {"delta_deg": 2.5}],
-    "extinction": [{"e": 0.9}, {"e": 0.7}],
-    "dop_bias": [{"bias": 0.01}, {"bias": 0.05}],
-    "oxide_layer": [{"thickness_um": 0.05, "n_film": 1.46}, {"thickness_um": 0.25, "n_film": 1.7}],
-    "lambertian": [{"rho_l": 0.05}, {"rho_l": 0.3}],
-    "subsurface": [{"rho_s": 0.2}, {"rho_s": 0.7}],
-    "volume": [{"w_vol": 0.5, "g_vol": 0.3, "pl_vol": 0.8, "pc_vol": 0.0}, {"w_vol": 1.0, "g_vol": -0.2, "pl_vol": 1.0, "pc_vol": 0.3}],
-    "volume_rayleigh": [{"w_ray": 0.5}, {"w_ray": 1.0}],
-    "phase_matrix": [{"w_pm": 0.5, "g_pm": 0.3, "n_pm": 1.3, "pm_m22_0": 0.9, "pm_m22_60": 0.6, "pm_m12_60": -0.5,
-                      "pm_m22_120": 0.5, "pm_m12_120": -0.4},
-                     {"w_pm": 1.0, "g_pm": -0.2, "n_pm": 1.25, "pm_m22_0": 0.8, "pm_m22_60": 0.4, "pm_m12_60": -0.8,
-                      "pm_m34_60": 0.3, "pm_m22_120": 0.3, "pm_m12_120": -0.7, "pm_m22_180": 0.5}],
-}
+# per built-in effect that composes with the base: its own small and large value (``Effect.hidden_values``)
+HIDDEN_VALUES = {cls.name: list(cls.hidden_values) for cls in BUILTIN_EFFECTS if cls.hidden_values}
 NOISE = [(0.002, 0.01), (0.01, 0.05)]  # (DOP absolute, BRDF relative): a good lab polarimeter, a field one
 WAVELENGTH_UM = 0.633
 

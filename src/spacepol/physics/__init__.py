@@ -2,6 +2,7 @@
 
 from .geometry import Geometry
 from .model import Model, Prediction, build_model
-from .effects import Effect, registry
+from .effect import Effect
+from .registry import registry
 
 __all__ = ["Geometry", "Model", "Prediction", "build_model", "Effect", "registry"]

@@ -18,7 +18,7 @@ import numpy as np
 
 from .._runtime import ensure_double_precision
 from .arrays import array_module
-from .builtin_effects import Specular
+from .effects.specular import Specular
 from .effect import Context, DepolarizedLobe, Effect, Ratio
 from .geometry import Geometry
 from .plugin_guard import is_plugin

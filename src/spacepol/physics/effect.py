@@ -153,6 +153,7 @@ class Effect:
     splits: dict = {}
     branches: tuple = ()
     intensity: str | None = None
+    hidden_values: tuple = ()  # values the hidden-effect suite hides in its renders (a small and a large one)
 
     def applicable(self, data) -> str | None:
         """None when the effect can be used with ``data``; else the reason, in words."""

@@ -1,12 +1,29 @@
-"""Effect registry: built-ins, the ``spacepol.effects`` entry-point group, and ``file.py:Name``."""
+"""Effect registry: the built-ins (one module each in ``physics/effects/``), the ``spacepol.effects`` entry-point
+group, and ``file.py:Name``."""
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 
 from ..errors import UnknownNameError
 from ..plugins import PluginRegistry
-from .builtin_effects import BUILTIN_EFFECTS, PRESETS
 from .effect import Effect
+
+PRESETS = {"paper": "specular+shadowing+body", "torrance-sparrow": "specular+shadowing"}
+
+
+def builtin_effects() -> tuple[type[Effect], ...]:
+    """The effect classes the modules of ``spacepol.physics.effects`` define, module by module in name order: adding
+    a built-in effect is adding one module there."""
+    from . import effects as package
+
+    found = []
+    for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{package.__name__}.{info.name}")
+        found += [obj for obj in vars(module).values() if isinstance(obj, type) and issubclass(obj, Effect)
+                  and obj.__module__ == module.__name__ and obj.name]
+    return tuple(found)
 
 
 class Registry(PluginRegistry):
@@ -43,6 +60,7 @@ class Registry(PluginRegistry):
         return names
 
 
+BUILTIN_EFFECTS = builtin_effects()
 registry = Registry()
 for _cls in BUILTIN_EFFECTS:
     registry.register(_cls)

@@ -11,11 +11,11 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from ..priors import Uniform
-from . import constrained_phase
-from .effect import Context
-from .parameter import Parameter
-from .volume import SingleScattering, henyey_greenstein
+from ...priors import Uniform
+from .. import constrained_phase
+from ..effect import Context
+from ..parameter import Parameter
+from ..single_scattering import SingleScattering, henyey_greenstein
 
 PREFIX = "pm_"
 SHAPE_NAMES = tuple(PREFIX + name for name, _ in constrained_phase.COORDINATES)
@@ -32,6 +32,12 @@ class PhaseMatrix(SingleScattering):
     """The ``phase_matrix`` effect: first-order volume scattering with a free-form, realizable phase matrix under
     an interface of its own index."""
     name = "phase_matrix"
+    hidden_values = (  # a small and a large value, for the hidden-effect suite
+        {"w_pm": 0.5, "g_pm": 0.3, "n_pm": 1.3, "pm_m22_0": 0.9, "pm_m22_60": 0.6, "pm_m12_60": -0.5, "pm_m22_120": 0.5,
+         "pm_m12_120": -0.4},
+        {"w_pm": 1.0, "g_pm": -0.2, "n_pm": 1.25, "pm_m22_0": 0.8, "pm_m22_60": 0.4, "pm_m12_60": -0.8, "pm_m34_60": 0.3,
+         "pm_m22_120": 0.3, "pm_m12_120": -0.7, "pm_m22_180": 0.5},
+    )
     requires = ()
     substitutes = ("subsurface",)  # a volume lobe may carry what a multiple-scattering body term fitted
     parameters = (

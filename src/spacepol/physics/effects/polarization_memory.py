@@ -15,9 +15,9 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from ..priors import Uniform
-from .effect import Context, Effect
-from .parameter import Parameter
+from ...priors import Uniform
+from ..effect import Context, Effect
+from ..parameter import Parameter
 
 
 def retention(f_mem, c_mem):

@@ -14,20 +14,21 @@ from .physics.model import Model, build_model
 
 
 def parse_settings(items, model: Model) -> dict[str, float]:
-    """``["n=1.5", "k=0"]`` -> {"n": 1.5, "k": 0.0}, checked against the model."""
+    """``["n=1.5", "k=0"]`` -> {"n": 1.5, "k": 0.0}: the text parsed here, the names and values checked by the API
+    (``parameter_values``)."""
+    from .api import parameter_values
+
     values = {}
     for item in items:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep or not name:
             raise ParameterError(f"--set '{item}': expected NAME=VALUE")
-        param = model.parameter(name)
         try:
-            value = float(text)
+            values[name] = float(text)
         except ValueError:
             raise ParameterError(f"--set '{item}': '{text}' is not a number") from None
-        param.check(value, where="--set")
-        values[name] = value
+        parameter_values(model, {name: values[name]}, where="--set")
     return values
 
 
@@ -201,7 +202,7 @@ def optimize(args) -> int:
     from .infer.engine_registry import SAMPLER, check_method, engines, optimize as run_optimizer
     from .infer.objective import PaperObjective
     from .infer.prior_set import PriorSet
-    from .io.atomic import _jsonable
+    from .io.atomic import jsonable
 
     check_method(args.method)
     data = load_dataset(args)
@@ -215,7 +216,7 @@ def optimize(args) -> int:
                                                    if n in {p.name for p in model.parameters}})
         result = run_optimizer(args.method, PaperObjective(data, model, model_priors),
                                np.random.default_rng(args.seed), model.name, seed=args.seed)
-    print(json.dumps(_jsonable(result.to_json()), indent=2))
+    print(json.dumps(jsonable(result.to_json()), indent=2))
     return 0
 
 

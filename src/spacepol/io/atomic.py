@@ -43,13 +43,14 @@ def atomic_path(path):
         raise
 
 
-def _jsonable(value):
+def jsonable(value):
+    """``value`` with numpy arrays and scalars turned into lists and floats, keys into strings: what json.dumps takes."""
     if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
+        return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
+        return [jsonable(v) for v in value]
     if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
+        return jsonable(value.tolist())
     if isinstance(value, (np.floating, float)):
         v = float(value)
         return v if np.isfinite(v) else None
@@ -61,7 +62,7 @@ def _jsonable(value):
 def write_json(path, data) -> None:
     """Write ``data`` as indented JSON (NumPy values converted), atomically."""
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(_jsonable(data), indent=2) + "\n", encoding="utf-8")
+        tmp.write_text(json.dumps(jsonable(data), indent=2) + "\n", encoding="utf-8")
 
 
 def write_text(path, text: str) -> None:

@@ -1,11 +1,11 @@
 """NIST full Mueller-matrix BRDF layout (Germer, Appl. Opt. 56, 2017; data/ptfe/).
 
-Columns: ``lambda`` (um), ``thetai`` (deg; incidence stored negative), ``phii``, ``thetar``,
-``phir`` (deg), ``fr11`` (sr^-1), then the 15 ratios m12 ... m44 = f_rij / f_r11 (header
-``f_r12/f_r11`` or ``m12``).  NIST's source with negative theta_i at phi_i = 0 lies at azimuth
-180 deg, and phi_r = 0 is the forward (specular) direction.  In spacepol's convention
-(source at phi_i = 0) that is  dphi = phi_source - phi_r  with phi_source = phi_i + 180 deg
-when theta_i < 0; the specular plane is then dphi = 180 deg as DESIGN.md fixes.
+Columns: ``lambda`` (um), ``thetai`` (deg; incidence stored negative), ``phii``, ``thetar``, ``phir`` (deg), ``fr11``
+(sr^-1), then the 15 ratios m12 ... m44 = f_rij / f_r11. Angles: dphi = phi_source - phi_r with phi_source = phi_i +
+180 deg when theta_i < 0 (the specular plane at dphi = 180 deg, as DESIGN.md fixes). Polarization frames: the file's
+matrices are in SCATMECH's x-y basis ("xyxy": each beam's frame tied to the sample's x and y axes), spacepol's in the
+s-p basis of each beam's plane of incidence ("psps"); the exit side turns by the scattering azimuth phi_s = 180 - dphi,
+M_sp = L(phi_s) M_xy (``xy_to_sp``; checked against SCATMECH's two bases in tests/test_io_cli.py).
 """
 
 from __future__ import annotations
@@ -27,6 +27,17 @@ def is_nist_header(header) -> bool:
     """True for the header of NIST's Mueller BRDF files (lambda, thetai, phii, ... and 16 ratio columns)."""
     lowered = [h.lower() for h in header]
     return len(lowered) >= 21 and lowered[0] == "lambda" and lowered[1] == "thetai"
+
+
+def xy_to_sp(mueller, phi_s_deg):
+    """Mueller matrices (4, 4, N) from SCATMECH's x-y basis to the s-p basis: the exit beam's frame turned by the
+    scattering azimuth ``phi_s_deg`` (0 = the specular direction), L(phi_s) M with L(a) the rotator
+    [[1, 0, 0, 0], [0, cos 2a, sin 2a, 0], [0, -sin 2a, cos 2a, 0], [0, 0, 0, 1]]. The incident frames agree (phi_i = 0)."""
+    a = 2.0 * np.radians(phi_s_deg)
+    c, s = np.cos(a), np.sin(a)
+    out = np.array(mueller, float, copy=True)
+    out[1], out[2] = c * mueller[1] + s * mueller[2], -s * mueller[1] + c * mueller[2]
+    return out
 
 
 def _wrap_deg(angle):
@@ -55,6 +66,9 @@ def read_nist_rows(path, header, lines, header_line, meta):
             raise InputFileError(path, f"wavelength {values[0]:g} um must be positive", line=line, column=header[0])
         if values[5] < 0:
             raise InputFileError(path, f"negative BRDF {values[5]:g}", line=line, column=header[5])
+        if values[2] != 0:
+            raise InputFileError(path, f"incidence azimuth {values[2]:g} deg: only 0 is read (the x-y basis of the "
+                                 "file's matrices is converted for incidence in the x-z plane)", line=line, column=header[2])
         for i in range(6, 21):
             check_element(values[i], path, line, header[i])
         check_first_column(values[9], values[13], values[17], path, line, f"{header[9]}, {header[13]}, {header[17]}")
@@ -74,6 +88,7 @@ def read_nist_rows(path, header, lines, header_line, meta):
     ratios = np.ones((4, 4, len(fr11)))
     for name in _RATIO_NAMES:
         ratios[int(name[1]) - 1, int(name[2]) - 1] = col[name]
+    ratios = xy_to_sp(ratios, 180.0 - dphi)
     mueller = ratios * fr11
     stokes = mueller[:, 0, :].copy()
     dop = np.sqrt(ratios[1, 0] ** 2 + ratios[2, 0] ** 2 + ratios[3, 0] ** 2)

@@ -257,7 +257,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
          + H.paragraph(f"Revealed: the hidden effect was {truth['hidden_effect']} with {truth['hidden_parameters']} ({found}).")),
         ("4. What the paper's model misses on PTFE", _criticism_section(ptfe_report, ptfe_rungs, out / "ptfe")
          + H.paragraph("What the measurement says about itself, without a model (all 1,824 geometries at 0.633 um; "
-                       "the PTFE study, reports/ptfe/report.md, fits every one of them):") + H.bullets(itself)),
+                       "the PTFE study, reports/ptfe_models/report.md, fits every one of them):") + H.bullets(itself)),
         ("5. Against the daytime sky: Table 3 as distributions", H.paragraph(
             f"The PTFE posterior (paper's model) at the paper's geometry (theta_i 30 deg, dphi 180 deg, theta_r 0-80 deg), "
             f"the sky of the paper's site and time (sun from astropy: zenith {sun[0]:.2f} deg, azimuth {sun[1]:.2f} deg; "

@@ -4,10 +4,9 @@
 
 each beam's Stokes frame its own plane of incidence (s horizontal, along the surface). In the plane of incidence it
 is a depolarizing mirror (s stays s, +45 deg becomes -45 deg); out of the plane it keeps the s/p frames instead of
-turning with the scattering plane. A multiply scattering medium layered parallel to its surface (pressed and sintered
-powders) treats the horizontal (s) field apart from the one with a vertical part (p) at every bounce; NIST's sintered
-PTFE shows such a residue in m22 and m33 at every azimuth that a once-scattering phase matrix, whose frame turns with
-the scattering plane, cannot give.
+turning with the scattering plane, as a multiply scattering medium layered parallel to its surface (pressed and
+sintered powders) would keep the horizontal (s) field apart from the one with a vertical part (p). A phenomenological
+term: the data decide whether they need it (``diagnose``).
 """
 
 from __future__ import annotations

@@ -23,10 +23,10 @@ MODELS = _CHOSEN + [f"specular+{cls.name}" for cls in BUILTIN_EFFECTS if cls.nam
 
 
 def test_models_cover_every_builtin():
-    from spacepol.physics.effects import BUILTIN_EFFECTS
-
     covered = {name for spec in MODELS for name in registry.expand(spec)}
     assert covered == {cls.name for cls in BUILTIN_EFFECTS}
+    for spec in MODELS:  # a built-in added without a chosen model must compose beside the facets alone
+        Model.from_string(spec)
 
 
 @st.composite

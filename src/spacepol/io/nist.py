@@ -5,7 +5,7 @@ Columns: ``lambda`` (um), ``thetai`` (deg; incidence stored negative), ``phii``,
 180 deg when theta_i < 0 (the specular plane at dphi = 180 deg, as DESIGN.md fixes). Polarization frames: the file's
 matrices are in SCATMECH's x-y basis ("xyxy": each beam's frame tied to the sample's x and y axes), spacepol's in the
 s-p basis of each beam's plane of incidence ("psps"); the exit side turns by the scattering azimuth phi_s = 180 - dphi,
-M_sp = L(phi_s) M_xy (``xy_to_sp``; checked against SCATMECH's two bases in tests/test_io_cli.py).
+M_sp = L(phi_s) M_xy (``xy_to_sp``; checked against SCATMECH's two bases in tests/test_nist_frames.py).
 """
 
 from __future__ import annotations

@@ -12,5 +12,5 @@ def __getattr__(name):
     if name in ("registry", "BUILTIN_EFFECTS", "PRESETS"):
         import importlib
 
-        return getattr(importlib.import_module(f"{__package__.rpartition('.')[0]}.registry"), name)
+        return getattr(importlib.import_module("..registry", __package__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

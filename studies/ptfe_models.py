@@ -37,7 +37,7 @@ import numpy as np  # noqa: E402
 
 from spacepol.criticism.reciprocity import mirror_asymmetry  # noqa: E402
 from spacepol.errors import SpacepolError  # noqa: E402
-from spacepol.infer.indices import index_findings  # noqa: E402
+from spacepol.infer.indices import INDEX_LIKE, index_findings  # noqa: E402
 from spacepol.infer.inference_data import median_fit  # noqa: E402
 from spacepol.infer.inversion import invert, laplace_fit  # noqa: E402
 from spacepol.infer.optimum import find_optimum_on_every  # noqa: E402
@@ -48,6 +48,7 @@ from spacepol.observables.mueller import GROUP_OF  # noqa: E402
 from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
 from spacepol.physics.spectral import SpectralModel, wavelength_label  # noqa: E402
+from spacepol.priors import Uniform  # noqa: E402
 
 MODELS = ("paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix,"
           "specular+smith+subsurface+phase_matrix+polarization_memory")
@@ -85,10 +86,22 @@ def anisotropy(data, noise: dict) -> dict:
     return out
 
 
+PHYSICAL = " [physical]"  # a model entry ending so: every index-like parameter's prior held to PTFE_BAND
+
+
 def model_for(data, spec: str):
+    """The model an entry of ``--models`` names, one index per wavelength where ``data`` hold several."""
     lams = np.unique(data.wavelength_um)
-    model = Model.from_string(spec)
+    model = Model.from_string(spec.removesuffix(PHYSICAL))
     return SpectralModel(model, lams) if len(lams) > 1 else model
+
+
+def index_priors(model, spec: str) -> dict:
+    """For an entry ending in ``PHYSICAL``: {every index-like parameter: Uniform over PTFE_BAND}, so that the fit says
+    what holding the indices physical costs; else nothing."""
+    if not spec.endswith(PHYSICAL):
+        return {}
+    return {p.name: Uniform(*PTFE_BAND) for p in model.parameters if p.name.split("@")[0] in INDEX_LIKE}
 
 
 def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
@@ -97,7 +110,8 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
     group, indices. ``search_every``: the global search on every n-th row, its optimum polished on all
     (``optimum.find_optimum_on_every``)."""
     start = time.perf_counter()
-    post = Posterior.build(data, model_for(data, spec))
+    model = model_for(data, spec)
+    post = Posterior.build(data, model, prior_overrides=index_priors(model, spec) or None)
     best, centre = find_optimum_on_every(post, search_every, np.random.default_rng(seed), evaluations=3000)
     found = time.perf_counter() - start
     print(f"  {spec}: maximum {best:.1f} in {found:.0f} s; posterior by {method}", flush=True)
@@ -210,6 +224,17 @@ def top_findings(records: list[dict]) -> list[str]:
     good = [i["text"] for i in best["indices"] if i["physical"]]
     if good:
         out.append("Determined and physical: " + "; ".join(good) + ".")
+    held = {r["model"].removesuffix(PHYSICAL): r for r in records if r["model"].endswith(PHYSICAL)}
+    for r in records:
+        if r["model"] in held:
+            h = held[r["model"]]
+            out.append(f"Held to the physical band [{PTFE_BAND[0]}, {PTFE_BAND[1]}], the indices of {r['model']} cost "
+                       f"{r['max_log_posterior'] - h['max_log_posterior']:.0f} log units of the maximum posterior "
+                       f"(ELPD-LOO {h['elpd_loo'] - r['elpd_loo']:.0f}) and raise the misfit to "
+                       + ", ".join(f"{g}@{w} {v:.2f}" for w, groups in h["misfit_ratio"].items() for g, v in groups.items())
+                       + "; they go to " + ", ".join(f"{i['name']} {i['median']:.3f}" for i in h["indices"])
+                       + f" (the band's edge): the data themselves, not the prior, push the indices out of the band. "
+                       + risen_most(r, h))
     ratios = {f"{g}@{w}": v for w, groups in best["misfit_ratio"].items() for g, v in groups.items()}
     above = [k for k, v in ratios.items() if v > GOAL_RATIO]
     out.append(f"Misfit of {best['model']} = RMS residual / the measured noise, per element group and wavelength: "
@@ -224,6 +249,22 @@ def top_findings(records: list[dict]) -> list[str]:
                            + ": that model's failure (a specular lobe that must carry the body's polarization), not a "
                            "measurement of PTFE's index.")
     return out
+
+
+GROUP_WORDS = {"pol": "the polarizance and diattenuation elements (m12 m13 m14 m21 m31 m41)",
+               "lin": "the linear block (m22 m23 m32 m33)", "circ": "the circular elements (m24 m34 m42 m43 m44)"}
+
+
+def risen_most(free: dict, held: dict) -> str:
+    """Which element group's misfit rises most when the indices are held physical, and what that says."""
+    rise = {g: np.mean([held["misfit_ratio"][w][g] - free["misfit_ratio"][w][g] for w in free["misfit_ratio"]])
+            for g in GROUP_WORDS}
+    group = max(rise, key=rise.get)
+    text = f"The misfit rises most in {GROUP_WORDS[group]} (+{rise[group]:.2f}x the measured noise on average)"
+    if group == "pol":
+        text += (": the flat interfaces of index >= 1.15 that the model's light crosses polarize it (Fresnel "
+                 "transmission's diattenuation) more than PTFE's porous surface does, so the fit flattens them to n ~ 1")
+    return text + "."
 
 
 def misfit_words(misfit: dict) -> str:
@@ -279,7 +320,7 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
 
 def pointwise_file(out: Path, spec: str) -> Path:
     """Where a model's pointwise ELPD-LOO is kept (the ranking's paired differences need it)."""
-    return out / "pointwise" / f"{spec.replace('+', '_')}.npy"
+    return out / "pointwise" / f"{spec.replace(PHYSICAL, '_physical').replace('+', '_')}.npy"
 
 
 def finished(out: Path, settings: dict) -> tuple[dict, dict | None, str | None]:
@@ -310,7 +351,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:  # every model named, before any work
         for spec in args.models.split(","):
-            Model.from_string(spec)
+            Model.from_string(spec.removesuffix(PHYSICAL))
     except SpacepolError as error:
         print(f"ptfe_models: --models: {error}", file=sys.stderr)
         return 2

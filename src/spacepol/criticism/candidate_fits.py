@@ -16,7 +16,8 @@ import numpy as np
 
 from ..infer import elpd_settled
 from ..infer.engines.base import SAMPLER, Engine
-from ..infer.inversion import invert, laplace_fit
+from ..infer.engine_registry import engines
+from ..infer.inversion import invert
 from ..infer.optimum import multistart, screen_optimum
 from ..infer.posterior import Posterior
 from ..physics.registry import registry
@@ -58,7 +59,7 @@ def _build(data, model, observables, priors, check: bool = True):
 
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
     """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
-    Laplace approximation corrected by importance sampling (``inversion.laplace_fit``), where its checks trust
+    Laplace approximation corrected by importance sampling (the registry's ``laplace`` engine), where its checks trust
     it, else emcee (why not: ``summary["laplace_refused"]``; stopped before convergence where the ELPD-LOO of its
     two halves agree, ``elpd_settled``); "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``,
     ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s
@@ -67,7 +68,7 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
         raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
     refusal = None
     if posterior_method == "laplace":
-        inv, refusal = laplace_fit(posterior, centre, seed=seed, draws=ELPD_DRAWS)
+        inv, refusal = engines.get("laplace").approximate(posterior, centre, seed=seed, draws=ELPD_DRAWS)
         if inv is not None:
             return inv
     inv = invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,

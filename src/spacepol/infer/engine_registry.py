@@ -16,7 +16,7 @@ from ..errors import SpacepolError, UnknownNameError
 from ..plugins import PluginRegistry
 from .engine_result import EngineResult
 from .engines.base import OPTIMIZER, SAMPLER, Engine
-from .engines.builtin import BUILTIN_ENGINES
+from .engines import builtin_engines
 
 class EngineRegistry(PluginRegistry):
     """Engine classes by name: built-ins, the ``spacepol.engines`` entry points, files loaded by ``get``; where each
@@ -65,7 +65,7 @@ def _article(word: str) -> str:
 
 
 engines = EngineRegistry()
-for _cls in BUILTIN_ENGINES:
+for _cls in builtin_engines():
     engines.register(_cls)
 
 

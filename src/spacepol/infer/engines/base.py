@@ -23,6 +23,7 @@ class Engine:
     kind: str = SAMPLER
     description: str = ""
     resumable: bool = False
+    default: bool = False  # the sampler used where none is named
     variants: tuple[str, ...] = ()  # the variants it accepts (empty: none)
 
     def __init__(self, variant: str | None = None):

@@ -9,6 +9,7 @@ from scipy.optimize import differential_evolution
 
 from .. import local_search
 from ..engine_result import EngineResult, History
+from .base import OPTIMIZER, Engine
 
 
 def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evaluations: int = 30000,
@@ -46,3 +47,14 @@ def run_de(objective, rng: np.random.Generator, model_name: str = "", max_evalua
         _, best_u = local_search.polish(lambda rows: f(rows.T), best_u, ftol=polish_ftol)
     return history.to_result("de", objective, model_name, time.perf_counter() - start, seed,
                              {"message": str(res.message), "iterations": int(res.nit)})
+
+
+class DifferentialEvolution(Engine):
+    """scipy's differential evolution on the prior cube, polished by L-BFGS-B (``engines.de.run_de``)."""
+
+    name, kind = "de", OPTIMIZER
+    description = "differential evolution (scipy), polished"
+
+    def run(self, objective, rng, **options):
+        """DE's best point and search history."""
+        return run_de(objective, rng, **options)

@@ -10,6 +10,7 @@ import time
 import numpy as np
 
 from ..engine_result import EngineResult, History
+from .base import OPTIMIZER, Engine
 
 
 def _decode(chromosomes, bits):
@@ -85,3 +86,14 @@ def _mutate(pop, rng, probability):
         else:  # basic position: flip one bit
             k = rng.integers(bits)
             pop[i, j, k] = 1.0 - pop[i, j, k]
+
+
+class GeneticAlgorithm(Engine):
+    """The paper's genetic algorithm on the prior cube (``engines.ga.run_ga``)."""
+
+    name, kind = "ga", OPTIMIZER
+    description = "the paper's genetic algorithm (binary genes, crossover, mutation)"
+
+    def run(self, objective, rng, **options):
+        """The GA's best point and search history."""
+        return run_ga(objective, rng, **options)

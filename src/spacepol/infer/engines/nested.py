@@ -9,12 +9,15 @@ The reasoning behind it, and what was measured: the internals page of the docume
 
 from __future__ import annotations
 
+import sys
+
 import time
 
 import numpy as np
 from scipy.special import logsumexp
 
 from ..engine_result import EngineResult
+from .base import SAMPLER, Engine
 
 
 def replicate_draws(points, log_w, rng: np.random.Generator, size: int) -> np.ndarray:
@@ -99,3 +102,23 @@ def missed_mode(posterior, draws: EngineResult, rng: np.random.Generator) -> dic
             "finding": (f"nested sampling missed a mode: a global search reaches log posterior {value:.2f} at ({at}), "
                         f"{value - best:.1f} above every draw it returned; its ln Z covers only the modes it found "
                         "(use emcee, which starts from the best mode, and compare)")}
+
+
+class Nested(Engine):
+    """Nested sampling (nautilus): the posterior and the evidence ln Z with its error from independent replicates
+    (``engines.nested``)."""
+
+    name, kind = "nested", SAMPLER
+    description = "nested sampling (nautilus): posterior and log evidence with its error"
+
+    def run(self, posterior, rng, live: int = 500, replicates: int = 3, networks: int = 1, effective_draws: int = 4000,
+            progress: bool = False):
+        """Draws and ln Z (``engines.nested.sample_nested``)."""
+        draws = sample_nested(posterior, rng, live=live, replicates=replicates, networks=networks,
+                              effective_draws=effective_draws, progress=progress)
+        missed = missed_mode(posterior, draws, rng)
+        if missed is not None:
+            draws.info["missed_mode"] = missed
+            if progress:
+                print(f"  {missed['finding']}", file=sys.stderr, flush=True)
+        return draws

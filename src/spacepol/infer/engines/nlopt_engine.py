@@ -9,6 +9,7 @@ import numpy as np
 
 from ...errors import UnknownNameError
 from ..engine_result import EngineResult, History
+from .base import OPTIMIZER, Engine
 
 NLOPT_ALGORITHMS = ["GN_CRS2_LM", "GN_ISRES", "GN_DIRECT_L", "GN_ESCH", "GN_MLSL_LDS"]
 
@@ -56,3 +57,20 @@ def run_nlopt(objective, algorithm: str, rng: np.random.Generator, model_name: s
         status = f"stopped: {type(exc).__name__}"
     return history.to_result(f"nlopt:{algorithm}", objective, model_name, time.perf_counter() - start, seed,
                              {"status": str(status)})
+
+
+class Nlopt(Engine):
+    """An nlopt algorithm on the prior cube (``nlopt:LN_SBPLX`` and the others in ``variants``)."""
+
+    name, kind = "nlopt", OPTIMIZER
+    description = "an nlopt algorithm, nlopt:ALGO"
+    variants = tuple(NLOPT_ALGORITHMS)  # the ones compare runs; any global (G*) algorithm of nlopt is taken
+
+    @classmethod
+    def check_variant(cls, variant: str) -> None:
+        """Any of nlopt's global algorithms (``GN_...``, ``GD_...``)."""
+        check_algorithm(variant)
+
+    def run(self, objective, rng, **options):
+        """The algorithm's best point and search history."""
+        return run_nlopt(objective, self.variant, rng, **options)

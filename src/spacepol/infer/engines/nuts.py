@@ -16,6 +16,7 @@ from ..differentiable import log_likelihood_function
 from ..engine_result import EngineResult
 from ..sampling_space import SamplingSpace
 from ..engine_result import ESS_TARGET, RHAT_TARGET
+from .base import SAMPLER, Engine
 
 
 def _potential(posterior, space):
@@ -86,3 +87,17 @@ def sample_nuts(posterior, rng: np.random.Generator, chains: int = 4, warmup: in
         objective_name="negative_log_posterior", n_evaluations=leapfrogs, seconds=time.perf_counter() - start,
         seed=-1 if seed is None else seed, samples=samples, log_prob=log_prob, info=info,
     )
+
+
+class Nuts(Engine):
+    """numpyro's NUTS on the compiled, differentiable likelihood in the logit space, dense mass matrix, several
+    chains, run in blocks until R-hat <= 1.01 and ESS >= 400 (or ``max_draws``)."""
+
+    name, kind = "nuts", SAMPLER
+    description = "No-U-Turn sampler (numpyro) on the differentiable likelihood"
+
+    def run(self, posterior, rng, chains: int = 4, warmup: int = 500, draws: int = 500, max_draws: int = 8000,
+            target_accept: float = 0.8, progress: bool = False):
+        """NUTS draws (``engines.nuts.sample_nuts``)."""
+        return sample_nuts(posterior, rng, chains=chains, warmup=warmup, draws=draws, max_draws=max_draws,
+                           target_accept=target_accept, progress=progress, model_name=posterior.likelihood.model.name)

@@ -233,7 +233,7 @@ def top_findings(records: list[dict]) -> list[str]:
                        f"(ELPD-LOO {h['elpd_loo'] - r['elpd_loo']:.0f}) and raise the misfit to "
                        + ", ".join(f"{g}@{w} {v:.2f}" for w, groups in h["misfit_ratio"].items() for g, v in groups.items())
                        + "; they go to " + ", ".join(f"{i['name']} {i['median']:.3f}" for i in h["indices"])
-                       + f" (the band's edge): the data themselves, not the prior, push the indices out of the band. "
+                       + " (the band's edge): the data themselves, not the prior, push the indices out of the band. "
                        + risen_most(r, h))
     ratios = {f"{g}@{w}": v for w, groups in best["misfit_ratio"].items() for g, v in groups.items()}
     above = [k for k, v in ratios.items() if v > GOAL_RATIO]

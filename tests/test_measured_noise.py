@@ -69,7 +69,7 @@ def test_the_measured_noise_floors_the_inferred_noise_and_runs_report_the_misfit
         assert posterior.priors.priors[group].lower == pytest.approx(floor) and 0.5 * 0.012 < floor < 0.012
     free = Posterior.build(data, Model.from_string("specular+subsurface"), noise_floor=False)
     assert free.priors.priors["sigma_m_lin"].lower == pytest.approx(1e-4)
-    from spacepol.infer.inversion import explains, noise_findings, noise_ratios
+    from spacepol.infer.draws_result import explains, noise_findings, noise_ratios
 
     summary_parameters = {g: {"median": 0.012 * r} for g, r in zip(GROUPS, (1.0, 1.2, 2.0))}
     noise = noise_ratios(posterior, summary_parameters)

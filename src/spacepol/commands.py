@@ -179,7 +179,7 @@ def run(args) -> int:
         from .infer.identifiability import bound_finding
 
         print(f"warning: {bound_finding(flag)}")
-    from .infer.inversion import noise_findings
+    from .infer.draws_result import noise_findings
 
     for line in noise_findings(summary.get("noise", {})):
         print(f"noise: {line}")

@@ -16,7 +16,7 @@ from ..infer import elpd_settled
 from ..infer.diagnostics import describe_fit, inferred_noise_levels
 from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
-from ..infer.inversion import explains
+from ..infer.draws_result import explains
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..infer.inversion import EXPLAINED_NOISE_RATIO, noise_findings
+from ..infer.draws_result import EXPLAINED_NOISE_RATIO, noise_findings
 from ..io.atomic import save_figure, write_text
 from . import html as H
 from ..infer.residuals import analyse

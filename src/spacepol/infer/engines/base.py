@@ -62,7 +62,7 @@ class Engine:
     def result(self, posterior, seed: int = 0, progress: bool = False, chain=None, **options) -> Result:
         """A sampler's Result: ``run`` with a Generator seeded by ``seed``, then the ArviZ groups, diagnostics, PSIS-LOO
         and summary. ``chain``: where a resumable engine keeps its chain (others ignore it)."""
-        from ..inversion import result_of
+        from ..draws_result import result_of
 
         start = time.perf_counter()
         rng = np.random.default_rng(seed)

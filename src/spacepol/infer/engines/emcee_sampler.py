@@ -16,7 +16,6 @@ from ..buffered_backend import BufferedHDFBackend
 from ..engine_result import ESS_TARGET, RHAT_TARGET, EngineResult
 from ..sampling_space import SamplingSpace, reaching_a_bound
 from .snooker import DESnookerMove
-from .base import SAMPLER, Engine
 
 
 def default_walkers(ndim: int) -> int:
@@ -279,31 +278,3 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         seconds=time.perf_counter() - start, seed=-1 if seed is None else seed,
         samples=chain, log_prob=log_prob, info=info,
     )
-
-
-class Emcee(Engine):
-    """emcee's affine-invariant ensemble in the logit space of the priors, run until R-hat <= 1.01, ESS >= 400 and
-    50 autocorrelation times (or ``max_steps``); its chain is kept in the output folder, so an interrupted run
-    continues."""
-
-    name, kind, resumable, default = "emcee", SAMPLER, True, True
-    description = "affine-invariant ensemble sampler (emcee), resumable; the default"
-
-    def run(self, posterior, rng, walkers: int | None = None, max_steps: int = 20000, tau_multiple: float = 50.0,
-            progress: bool = False):
-        """emcee's draws (``engines.emcee_sampler.sample_emcee``)."""
-        return sample_emcee(posterior, rng, walkers=walkers, max_steps=max_steps, tau_multiple=tau_multiple,
-                            progress=progress, model_name=posterior.likelihood.model.name)
-
-    def result(self, posterior, seed: int = 0, progress: bool = False, chain=None, **options):
-        """``inversion.invert``: the start-point search, the chain (kept in ``chain`` when given), the Result."""
-        from ..inversion import invert
-
-        self.check_options(options)
-        return invert(posterior, seed=seed, backend_path=chain, progress=progress, **options)
-
-    def check_chain(self, chain, posterior, seed: int, walkers: int | None = None, **_) -> None:
-        """A chain already in ``chain`` must be readable and belong to this run (before any work)."""
-        from ..inversion import check_resumable
-
-        check_resumable(chain, posterior, walkers, seed)

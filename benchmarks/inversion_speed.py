@@ -71,7 +71,7 @@ def run_emcee(posterior, seed, space):
     t0 = time.perf_counter()
     inv = invert(posterior, seed=seed, progress=False, space=space)
     wall = time.perf_counter() - t0
-    d, info = inv.summary["diagnostics"], inv.draws.info
+    d, info = inv.summary.diagnostics, inv.draws.info
     return wall, d["ess_min"], d["rhat_max"], (f"{info['steps']} steps x {info['walkers']} walkers, tau_max "
                                                f"{info['tau_max']:.0f}, space {info['space']}"), info["capped"]
 

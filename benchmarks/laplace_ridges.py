@@ -48,7 +48,7 @@ def main():
             exact = reference.draws.flat_samples().std(0)
             print(f"\n{truth_name}, BRDF noise {noise:g}: emcee SDs " + ", ".join(
                 f"{n} {v:.3g}" for n, v in zip(post.names, exact)) + f" ({REFERENCE_TAUS} autocorrelation times, ESS "
-                f"{reference.summary['diagnostics']['ess_min']:.0f}, {time.perf_counter() - start:.0f} s)")
+                f"{reference.summary.diagnostics['ess_min']:.0f}, {time.perf_counter() - start:.0f} s)")
             print("| seed | weights' checks | IS SD / emcee (n, k) | walkers' growth (n, k) | ran | returned SD / emcee, min | s |")
             print("|---|---|---|---|---|---|---|")
             for seed in args.seeds:
@@ -60,7 +60,7 @@ def main():
                           if trusted else [np.nan, np.nan])
                 start = time.perf_counter()
                 result = laplace.result(post, seed=seed)
-                ran = result.summary["diagnostics"]["engine"]
+                ran = result.summary.diagnostics["engine"]
                 ratio = result.draws.flat_samples().std(0) / exact
                 print(f"| {seed} | {'trusted' if trusted else 'refused'} | {is_ratio[0]:.2f}, {is_ratio[1]:.2f} | "
                       f"{growth[0]:.2f}, {growth[1]:.2f} | {ran} | {ratio.min():.2f} ({post.names[int(np.argmin(ratio))]}) | "

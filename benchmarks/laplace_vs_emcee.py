@@ -59,13 +59,13 @@ def main():
         e = exact.draws.flat_samples()
         peak = log_prob_z(space.to_z(e)).max()
         print(f"{name} ({post.ndim} parameters): emcee {t_emcee:.1f} s ({exact.draws.info['steps']} steps, "
-              f"R-hat {exact.summary['diagnostics']['rhat_max']:.4f}), E[-2 dlogp] {np.mean(-2 * (log_prob_z(space.to_z(e)) - peak)):.2f}")
+              f"R-hat {exact.summary.diagnostics['rhat_max']:.4f}), E[-2 dlogp] {np.mean(-2 * (log_prob_z(space.to_z(e)) - peak)):.2f}")
         if approx is None:
             print(f"  Laplace-IS: not trusted here (Pareto k > 0.7 or too few effective draws): diagnose uses emcee "
                   f"({t_laplace:.1f} s spent finding out)")
             continue
         a = approx.draws.flat_samples()
-        d = approx.summary["diagnostics"]
+        d = approx.summary.diagnostics
         shift = (a.mean(0) - e.mean(0)) / e.std(0)
         ratio = a.std(0) / e.std(0)
         diff = approx.loo["pointwise"] - exact.loo["pointwise"]

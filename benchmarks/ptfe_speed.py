@@ -81,7 +81,7 @@ def main():
         with tempfile.TemporaryDirectory() as tmp:
             write_run_report(inv, Path(tmp), "ptfe")
         wall = time.perf_counter() - t0
-        d, info = inv.summary["diagnostics"], inv.draws.info
+        d, info = inv.summary.diagnostics, inv.draws.info
         budget = BUDGET_MIN["all" if which == "all" else "one"]
         rows.append((which, wall, sampled, budget))
         print(f"[{which}] converged posterior in {sampled / 60:.1f} min (+ report {(wall - sampled) / 60:.1f} min = "

@@ -60,10 +60,10 @@ def main():
         posterior = Posterior.build(data, model)
         ga = optimize("ga", PaperObjective(data, model, PriorSet(model.parameters)), rng, model.name)
         inv = invert(posterior, seed=args.seed, progress=False, max_steps=60000)
-        q = inv.summary["parameters"]
+        q = inv.summary.parameters
         results[name] = {"truth": truth, "ga": ga.best, "ga_objective": ga.objective, "ga_evaluations": ga.n_evaluations,
-                         "ga_stop": ga.info["stop_reason"], "posterior": q, "diagnostics": inv.summary["diagnostics"],
-                         "identifiability": inv.summary["identifiability"]["findings"]}
+                         "ga_stop": ga.info["stop_reason"], "posterior": q, "diagnostics": inv.summary.diagnostics,
+                         "identifiability": inv.summary.identifiability["findings"]}
         for p in ("n", "k", "sigma", "ks", "rho_d"):
             rows.append(f"| {name} | {p} | {truth[p]:.4g} | {ga.best[p]:.4g} | {q[p]['median']:.4g} "
                         f"[{q[p]['q05']:.4g}, {q[p]['q95']:.4g}] | "

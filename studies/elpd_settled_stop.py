@@ -57,7 +57,7 @@ def main():
                          tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS,
                          elpd_tolerance=elpd_settled.TOLERANCE)
             diff = inv.loo["pointwise"] - base_loo
-            s = inv.summary["sampler"]
+            s = inv.summary.sampler
             how = ("converged" if inv.diagnostics.converged else "ELPD settled" if s.get("stopped_early") else "at the cap")
             print(f"{spec}, seed {seed}: {how} at {s['steps']} steps ({time.perf_counter() - start:.0f} s), R-hat "
                   f"{inv.diagnostics.rhat_max:.3f}, delta ELPD {diff.sum():+.1f} +- {np.sqrt(len(diff) * np.var(diff)):.1f}; "

@@ -120,17 +120,17 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
         print(f"  {spec}: emcee ({refusal})", flush=True)
         inv = invert(post, seed=seed, progress=False, centre=centre, max_steps=max_steps, max_pointwise_draws=2000)
     s = inv.summary
-    parameters = s["parameters"] | s.get("derived", {})
+    parameters = s.parameters | s.derived
     z = standardised(inv, noise)
     record = {
-        "model": spec, "free_parameters": post.ndim, "max_log_posterior": best, "engine": s["diagnostics"]["engine"],
-        "laplace_refused": "" if method != "laplace" else refusal, "rhat_max": s["diagnostics"]["rhat_max"],
-        "elpd_loo": s["fit"]["elpd_loo"], "elpd_loo_se": s["fit"]["elpd_loo_se"],
-        "inferred_noise": {k: v["median"] for k, v in s["parameters"].items() if k.startswith("sigma_m_")},
+        "model": spec, "free_parameters": post.ndim, "max_log_posterior": best, "engine": s.diagnostics["engine"],
+        "laplace_refused": "" if method != "laplace" else refusal, "rhat_max": s.diagnostics["rhat_max"],
+        "elpd_loo": s.fit["elpd_loo"], "elpd_loo_se": s.fit["elpd_loo_se"],
+        "inferred_noise": {k: v["median"] for k, v in s.parameters.items() if k.startswith("sigma_m_")},
         "misfit_ratio": group_ratios(z, data),
         "indices": [{"name": f.name, "median": f.median, "q05": f.q05, "q95": f.q95, "determined": f.determined,
                      "physical": f.physical, "text": f.text} for f in index_findings(parameters, PTFE_BAND)],
-        "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s["identifiability"]["at_bound"]],
+        "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s.at_bound],
         "seconds": time.perf_counter() - start,
     }
     return record, inv, z

@@ -68,12 +68,12 @@ def model_for(data, spec: str):
 
 def medians(inv) -> dict:
     names = {p.name for p in inv.posterior.likelihood.model.parameters}
-    return {k: v["median"] for k, v in inv.summary["parameters"].items() if k in names}
+    return {k: v["median"] for k, v in inv.summary.parameters.items() if k in names}
 
 
 def index_posteriors(inv, data) -> dict:
     """{wavelength label: quantiles of n there} (n itself at one wavelength)."""
-    p = inv.summary["parameters"] | inv.summary.get("derived", {})
+    p = inv.summary.parameters | inv.summary.derived
     labels = [f"{w:g}" for w in np.unique(data.wavelength_um)]
     if len(labels) == 1:
         return {labels[0]: p["n"]} if "n" in p else {}
@@ -91,20 +91,20 @@ def element_rms(inv) -> dict:
 
 def rung_record(step: dict, inv, data) -> dict:
     s = inv.summary
-    runs = s["residual_structure"].get("runs", {})
+    runs = s.residual_structure.get("runs", {})
     return {
-        "noise": {k: {f: v[f] for f in ("inferred", "measured", "ratio")} for k, v in s.get("noise", {}).items()},
+        "noise": {k: {f: v[f] for f in ("inferred", "measured", "ratio")} for k, v in s.noise.items()},
         "element_rms": element_rms(inv),
         "model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
         "delta_elpd_se": step["delta_elpd_se"], "tied_with": step.get("tied_with", []),
-        "elpd_loo": s["fit"]["elpd_loo"], "elpd_loo_se": s["fit"]["elpd_loo_se"], "rmse_dop": s["fit"]["rmse_dop"],
+        "elpd_loo": s.fit["elpd_loo"], "elpd_loo_se": s.fit["elpd_loo_se"], "rmse_dop": s.fit["rmse_dop"],
         "inferred_noise": inferred_noise_levels(s),
         "runs_z": {ch: r["z"] for ch, r in runs.items()},
-        "structured": bool(s["residual_structure"].get("structured")),
-        "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s["identifiability"].get("at_bound", [])],
+        "structured": bool(s.residual_structure.get("structured")),
+        "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s.at_bound],
         "n": index_posteriors(inv, data),
         "reciprocity": reciprocity.model_violation(inv.posterior.likelihood.model, medians(inv), data.geometry),
-        "rhat_max": s["diagnostics"]["rhat_max"], "seconds": s["seconds"],
+        "rhat_max": s.diagnostics["rhat_max"], "seconds": s.seconds,
     }
 
 

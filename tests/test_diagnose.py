@@ -198,10 +198,11 @@ def test_a_refit_whose_chain_did_not_converge_is_said_so():
     from spacepol.criticism.diagnose import posterior_quality
     from spacepol.infer.engine_result import EngineResult
     from spacepol.infer.result import Result
+    from spacepol.infer.run_summary import RunSummary
 
     def fit(engine, rhat=None, ess=None, steps=None):
-        summary = {"model": "paper", "seed": 0, "sampler": {"steps": steps},
-                   "diagnostics": {"engine": engine, "rhat_max": rhat, "ess_min": ess, "pareto_k": 0.4}}
+        summary = RunSummary(model="paper", seed=0, sampler={"steps": steps},
+                             diagnostics={"engine": engine, "rhat_max": rhat, "ess_min": ess, "pareto_k": 0.4})
         draws = EngineResult(method=engine or "emcee", model="paper", names=[], best={}, objective=0.0, objective_name="",
                              n_evaluations=0, seconds=0.0, seed=0)
         return Result(None, draws, None, summary, {}, {})

@@ -135,11 +135,11 @@ def _check_nested(data, prior, wider, reference, options):
     as wide in sigma (``wider``) moves ln Z by ln 2 and fails the same comparison."""
     result = spacepol.invert(data, "paper", prior=prior, engine="nested", seed=1, engine_options=options)
     (log_z, error), (expected, expected_se) = result.log_evidence, _importance_log_evidence(data, prior, reference)
-    assert np.isfinite(error) and error > 0 and result.summary["log_evidence"]["error"] == error
+    assert np.isfinite(error) and error > 0 and result.summary.log_evidence["error"] == error
     tolerance = 4 * np.hypot(error, expected_se)
     assert abs(log_z - expected) < tolerance
     assert max(_agree(result, reference).values()) < 4 and result.diagnostics.rhat_max < 1.01
-    assert "missed_mode" not in result.summary["sampler"]  # the control of the missed-mode check below
+    assert "missed_mode" not in result.summary.sampler  # the control of the missed-mode check below
     other, _ = _importance_log_evidence(data, {**prior, "sigma": wider}, reference)
     assert abs(other - (expected - np.log(2))) < 4 * expected_se and abs(log_z - other) > tolerance
 
@@ -168,7 +168,7 @@ def test_nested_sampling_that_missed_the_best_mode_says_so(data, monkeypatch):
     monkeypatch.setattr(nested_module, "sample_nested", stranded)
     result = spacepol.invert(data, "paper", prior=NARROW, engine="nested", seed=1,
                              engine_options={"live": 100, "replicates": 2, "effective_draws": 300})
-    missed = result.summary["sampler"]["missed_mode"]
+    missed = result.summary.sampler["missed_mode"]
     assert missed["log_posterior"] > missed["best_sampled"] + 4 and abs(missed["at"]["n"] - 1.6) < 0.02
     assert "ln Z covers only the modes it found" in missed["finding"]
 

@@ -51,7 +51,7 @@ def test_a_parameter_at_its_bound_is_sampled_in_the_declared_parameters_and_agre
     """k piles at 0: the t at the logit-CDF mode is refused (its Pareto k > 0.7, the control), the adapted mixture in
     the declared parameters is accepted and agrees with emcee."""
     post, centre, approx, exact = at_bound
-    assert exact.summary["parameters"]["k"]["q05"] < 0.01  # the posterior does reach the bound
+    assert exact.summary.parameters["k"]["q05"] < 0.01  # the posterior does reach the bound
     assert approx is not None and "declared parameters" in approx.draws.info["proposal"]
     _assert_agreement(post, centre, approx, exact)
     in_z = laplace_importance(post, centre, np.random.default_rng(1), adapt=False)
@@ -61,10 +61,10 @@ def test_a_parameter_at_its_bound_is_sampled_in_the_declared_parameters_and_agre
 
 def _assert_agreement(post, centre, approx, exact):
     assert approx is not None, "the approximation was refused"
-    d = approx.summary["diagnostics"]
+    d = approx.summary.diagnostics
     assert d["pareto_k"] <= 0.7 and d["ess_min"] >= 400 and d["rhat_max"] is None
     a, e = approx.draws.flat_samples(), exact.draws.flat_samples()
-    ess_emcee, ess_is = exact.summary["diagnostics"]["ess_min"], d["ess_min"]
+    ess_emcee, ess_is = exact.summary.diagnostics["ess_min"], d["ess_min"]
     # Monte-Carlo standard errors (in posterior SDs) of a mean and of an SD from n effective draws: 1/sqrt(n), 1/sqrt(2n)
     mean_se = np.sqrt(1 / ess_emcee + 1 / ess_is)
     sd_se = np.sqrt(1 / (2 * ess_emcee) + 1 / (2 * ess_is))
@@ -81,7 +81,7 @@ def test_a_shifted_posterior_fails_the_same_comparison(near_gaussian):
     post, _, approx, exact = near_gaussian
     a, e = approx.draws.flat_samples(), exact.draws.flat_samples().copy()
     e[:, 0] += 0.5 * e[:, 0].std()
-    mean_se = np.sqrt(1 / exact.summary["diagnostics"]["ess_min"] + 1 / approx.summary["diagnostics"]["ess_min"])
+    mean_se = np.sqrt(1 / exact.summary.diagnostics["ess_min"] + 1 / approx.summary.diagnostics["ess_min"])
     assert np.abs(a.mean(0)[0] - e.mean(0)[0]) / e.std(0)[0] > 4 * mean_se
 
 

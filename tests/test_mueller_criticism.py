@@ -63,7 +63,7 @@ def test_the_whole_library_on_full_mueller_sets(kind):
     """As the held-out check runs: the whole library, base `specular`, the default observables (the set holds
     DOP, BRDF and the Mueller matrix: the default fits the Mueller matrix and the BRDF, DOP being its first column)."""
     report = _diagnose(kind, None, None)
-    fitted = report.base.summary["observables"]
+    fitted = report.base.summary.observables
     assert "brdf" in fitted and "m44" in fitted and "dop" not in fitted, fitted
     expected = {"none": {"none"}, "depolarization": {"depolarization"}, "extinction": {"extinction"},
                 "subsurface": {"subsurface", "polarized_diffuse"}}[kind]

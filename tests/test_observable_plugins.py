@@ -98,7 +98,7 @@ def test_an_inversion_of_dolp_and_brdf_recovers_the_index_and_a_wrong_index_is_e
                        "brdf": data.brdf, "brdf_err": data.brdf_err})
     prior = {"k": Fixed(TRUTH["k"])}  # DoLP and BRDF leave n and k on a ridge; k known, n is measured
     result = spacepol.invert(path, MODEL, prior=prior, engine="laplace", seed=1)
-    assert result.summary["observables"] == ["brdf", "dolp"]
+    assert result.summary.observables == ["brdf", "dolp"]
     draws = result.samples()
     for name in ("n", "sigma", "ks"):
         median, sd = np.median(draws[name]), np.std(draws[name])

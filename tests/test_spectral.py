@@ -71,14 +71,14 @@ def _check_cauchy_fit(cauchy_fit):
     """The law's 90 % intervals cover A and B; the shared parameters lie within 3 posterior sd (five 90 %
     intervals all covering would fail on 41 % of noise draws). Negative control: the n(lambda) of another law
     (B = 0.02) is not covered."""
-    p = cauchy_fit.summary["parameters"]
-    assert cauchy_fit.summary["diagnostics"]["rhat_max"] <= 1.01
+    p = cauchy_fit.summary.parameters
+    assert cauchy_fit.summary.diagnostics["rhat_max"] <= 1.01
     for name in ("n_cauchy_a", "n_cauchy_b"):
         assert p[name]["q05"] <= TRUTH[name] <= p[name]["q95"], (name, p[name])
     for name in ("sigma", "ks", "rho_l"):
         sd = 0.5 * (p[name]["q84"] - p[name]["q16"])
         assert abs(p[name]["median"] - TRUTH[name]) < 3 * sd, (name, p[name])
-    derived = cauchy_fit.summary["derived"]  # n at each wavelength, as DESIGN names them
+    derived = cauchy_fit.summary.derived  # n at each wavelength, as DESIGN names them
     assert list(derived) == ["n@0.351", "n@0.532", "n@0.633", "n@1.064"]
     for lam in LAMBDAS:
         q = derived[f"n@{lam:g}"]
@@ -111,7 +111,7 @@ def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per
     assert {"n@0.532", "n@1.064", "rho_l"} <= {p.name for p in changed.parameters}
     hidden = diagnose(render(changed, truth), base, np.random.default_rng(0), candidates=["lambertian", "oxide_layer"], top=1)
     assert hidden["verdict"] == "lambertian", hidden["ranking"][:2]
-    assert "n@1.064" in hidden.base.summary["parameters"]
+    assert "n@1.064" in hidden.base.summary.parameters
 
 
 @pytest.mark.slow  # 15 s; the null half of diagnose is in the default suite on one wavelength (test_diagnose)

@@ -68,10 +68,10 @@ def test_the_dop_ridges_trusted_draws_are_refused_by_the_walkers_spread_too():
 def test_the_laplace_engine_falls_back_to_emcee_and_says_so(tmp_path):
     """Where the gate refuses, ``engine="laplace"`` samples with emcee: the summary names what ran and why."""
     result = spacepol.invert(band_data(METAL, brdf_noise=1.0), "paper", engine="laplace", seed=1, out=tmp_path / "run")
-    assert result.summary["diagnostics"]["engine"] == result.summary["engine"] == "emcee"
-    assert "spread beyond them" in result.summary["laplace_refused"]
+    assert result.summary.diagnostics["engine"] == result.summary.engine == "emcee"
+    assert "spread beyond them" in result.summary.laplace_refused
     saved = spacepol.Result.load(tmp_path / "run")
-    assert saved.summary["engine"] == "emcee" and saved.summary["laplace_refused"]
+    assert saved.summary.engine == "emcee" and saved.summary.laplace_refused
     assert "Laplace approximation was refused" in (tmp_path / "run" / "report.html").read_text()
     # the fallback keeps its chain in the run folder, as emcee does: the same call again reads it instead of sampling
     assert (tmp_path / "run" / "chain.h5").exists()

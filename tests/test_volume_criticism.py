@@ -31,7 +31,7 @@ def _final_summary(result) -> dict:
         return reports[0].base.summary
     for report in reversed(reports):
         for c in report.confirmed:
-            if c.label == last["change"] and c.inversion.summary["model"] == last["model"]:
+            if c.label == last["change"] and c.inversion.summary.model == last["model"]:
                 return c.inversion.summary
     raise AssertionError("the final model's inversion is not among the rounds' refits")
 

@@ -55,13 +55,22 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The `invert-mcmc` argument parser: every command, option and its help (the CLI reference is generated from it)."""
-    parser = _Parser(prog="invert-mcmc", description="Probabilistic inversion of polarimetric reflectance.")
-    parser.add_argument("--effect", action="append", default=[], metavar="FILE.py:NAME",
-                        help="load a user-defined effect (repeatable); it is then usable by name")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+def _data_options(p) -> None:
+    """The options every command that reads a measurement file takes."""
+    p.add_argument("data", help="measurement file (spacepol CSV or NIST Mueller BRDF)")
+    p.add_argument("--model", default="paper")
+    p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
+    p.add_argument("--wavelength-um", type=_wavelengths, metavar="UM|LIST|all",
+                   help="one wavelength of a multi-wavelength file, a comma list, or all (inverted jointly: "
+                        "n, k per wavelength as n@LAMBDA, the rest shared)")
+    p.add_argument("--dispersion", metavar="n=cauchy", help="a dispersion law for n over several wavelengths")
+    p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
+    p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
+    p.add_argument("--seed", type=SEED, default=0)
 
+
+def _data_commands(sub) -> None:
+    """demo, forward, synth, effects: the forward model and the bundled data."""
     p = sub.add_parser("demo", help="the whole chain on bundled data; report in DIR")
     p.add_argument("--out", default="reports/demo")
 
@@ -84,20 +93,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("effects", help="list every registered effect: parameters, priors, units, physics")
 
-    def data_options(p):
-        p.add_argument("data", help="measurement file (spacepol CSV or NIST Mueller BRDF)")
-        p.add_argument("--model", default="paper")
-        p.add_argument("--prior", metavar="FILE.toml", help="prior overrides (and fixed parameters)")
-        p.add_argument("--wavelength-um", type=_wavelengths, metavar="UM|LIST|all",
-                       help="one wavelength of a multi-wavelength file, a comma list, or all (inverted jointly: "
-                            "n, k per wavelength as n@LAMBDA, the rest shared)")
-        p.add_argument("--dispersion", metavar="n=cauchy", help="a dispersion law for n over several wavelengths")
-        p.add_argument("--in-plane", action="store_true", help="keep only the plane of incidence (dphi = 0, 180)")
-        p.add_argument("--observables", help="comma-separated dop,brdf,q,u (default: dop and brdf where the file has them)")
-        p.add_argument("--seed", type=SEED, default=0)
 
+def _inference_commands(sub) -> None:
+    """run, optimize, compare: posteriors and the optimizers."""
     p = sub.add_parser("run", help="posterior (emcee by default) with corner, fit and residual plots and a report")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--walkers", type=_int_at_least(2), default=None, help="even, >= 2 x parameters (default 32 or more)")
     p.add_argument("--steps", type=_int_at_least(100), default=None, help="emcee: cap on the chain length (default 20000)")
     p.add_argument("--engine", default="emcee", metavar="NAME",
@@ -114,17 +114,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/run")
 
     p = sub.add_parser("optimize", help="one optimizer's best fit as JSON on stdout")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--method", required=True, help="ga, de, emcee, or nlopt:ALGO")
 
     p = sub.add_parser("compare", help="every optimizer, several seeds, against the posterior")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--methods", nargs="+", default=None)
     p.add_argument("--seeds", type=_int_at_least(1), default=3, help="runs per method")
     p.add_argument("--out", default="reports/compare")
 
+
+def _criticism_commands(sub) -> None:
+    """diagnose, ladder, design, batch: model criticism and many sets."""
     p = sub.add_parser("diagnose", help="rank the registered effects that would explain the misfit")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--json", required=True, metavar="FILE", help="write the ranking here")
     p.add_argument("--candidates", nargs="+", default=None, help="effects to consider (default: every registered one)")
     p.add_argument("--top", type=_int_at_least(1), default=3, help="candidates confirmed by a full refit")
@@ -142,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/diagnose")
 
     p = sub.add_parser("ladder", help="fit M, M + E1, M + E1 + E2, ...: the error falling rung by rung")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--add", action="append", default=[], metavar="CHANGE",
                    help="the next rung's change: an effect to add, or 'replace A by B', or 'remove E' (repeatable)")
     p.add_argument("--replay", metavar="DIAGNOSE.json", help="replay the path of `diagnose --rounds` (its changes, in order)")
@@ -150,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/ladder")
 
     p = sub.add_parser("design", help="which further measurements would break a degeneracy (Fisher information)")
-    data_options(p)
+    _data_options(p)
     p.add_argument("--picks", type=_int_at_least(1), default=3, help="measurements to propose (chosen greedily)")
     p.add_argument("--noise", action="append", default=[], metavar="OBS=X",
                    help="assumed noise of a new measurement of observable OBS, e.g. dop=0.005, brdf=0.03 (relative), "
@@ -168,6 +171,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--out", default="reports/batch")
 
+
+def _sky_commands(sub) -> None:
+    """sky, contrast, observe, frame: from a posterior to the sky and a camera."""
     p = sub.add_parser("sky", help="the sun (astropy) and the sky's polarization at a site and time; maps")
     p.add_argument("--lat", type=_finite(), required=True, metavar="DEG", help="latitude, north positive")
     p.add_argument("--lon", type=_finite(), required=True, metavar="DEG", help="longitude, east positive")
@@ -211,6 +217,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("raw", metavar="RAW.png", help="an 8- or 16-bit single-channel image of the raw mosaic")
     p.add_argument("--method", choices=("superpixel", "bilinear"), default="superpixel")
     p.add_argument("--out", default=None, help="default: a folder named after the image, beside it")
+
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The `invert-mcmc` argument parser: every command, option and its help (the CLI reference is generated from it)."""
+    parser = _Parser(prog="invert-mcmc", description="Probabilistic inversion of polarimetric reflectance.")
+    parser.add_argument("--effect", action="append", default=[], metavar="FILE.py:NAME",
+                        help="load a user-defined effect (repeatable); it is then usable by name")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    for add_commands in (_data_commands, _inference_commands, _criticism_commands, _sky_commands):
+        add_commands(sub)
     for p in sub.choices.values():  # --effect also after the command name, where users put it
         p.add_argument("--effect", action="append", default=[], dest="effect_after", metavar="FILE.py:NAME",
                        help="load a user-defined effect (repeatable); it is then usable by name")

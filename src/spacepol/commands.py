@@ -10,26 +10,8 @@ from .errors import ParameterError
 from .io import Dataset, read_measurements, write_table
 from .io.output import check_output_dir, check_output_file
 from .physics.geometry import Geometry
+from .api.inputs import parse_engine_options, parse_references, parse_settings
 from .physics.model import Model, build_model
-
-
-def parse_settings(items, model: Model) -> dict[str, float]:
-    """``["n=1.5", "k=0"]`` -> {"n": 1.5, "k": 0.0}: the text parsed here, the names and values checked by the API
-    (``parameter_values``)."""
-    from .api import parameter_values
-
-    values = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise ParameterError(f"--set '{item}': expected NAME=VALUE")
-        try:
-            values[name] = float(text)
-        except ValueError:
-            raise ParameterError(f"--set '{item}': '{text}' is not a number") from None
-        parameter_values(model, {name: values[name]}, where="--set")
-    return values
 
 
 def _prediction_columns(geometry: Geometry, prediction) -> dict:
@@ -127,41 +109,6 @@ def build_posterior(args, data, robust=False):
     return posterior_of(data, args.model, args.prior, args.observables, getattr(args, "dispersion", None), robust)
 
 
-def parse_references(items) -> dict[str, float]:
-    """``["n=1.35"]`` -> {"n": 1.35}; the API checks the names against the model's free parameters."""
-    refs = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        if not sep:
-            raise ParameterError(f"--reference '{item}': expected NAME=VALUE")
-        try:
-            refs[name] = float(text)
-        except ValueError:
-            raise ParameterError(f"--reference '{item}': '{text}' is not a number") from None
-    return refs
-
-
-def parse_engine_options(items) -> dict:
-    """``["replicates=5", "live=300"]`` -> {"replicates": 5, "live": 300}: whole numbers as int, other numbers as
-    float, true/false as bool, the rest as text; the engine checks the names."""
-    options = {}
-    for item in items:
-        name, sep, text = item.partition("=")
-        if not sep or not name.strip():
-            raise ParameterError(f"--engine-option '{item}': expected KEY=VALUE")
-        value: object = text
-        for convert in (int, float):
-            try:
-                value = convert(text)
-                break
-            except ValueError:
-                continue
-        if text.lower() in ("true", "false"):
-            value = text.lower() == "true"
-        options[name.strip()] = value
-    return options
-
-
 def run(args) -> int:
     """``invert-mcmc run``: ``api.invert`` with the run's report; prints the findings and the convergence figures."""
     from .api import invert
@@ -175,22 +122,22 @@ def run(args) -> int:
                      robust=args.robust, restart=args.restart, progress=not args.quiet,
                      references=parse_references(args.reference),
                      engine_options=parse_engine_options(args.engine_option)).summary
-    for flag in summary["identifiability"].get("at_bound", []):
+    for flag in summary.at_bound:
         from .infer.identifiability import bound_finding
 
         print(f"warning: {bound_finding(flag)}")
     from .infer.draws_result import noise_findings
 
-    for line in noise_findings(summary.get("noise", {})):
+    for line in noise_findings(summary.noise):
         print(f"noise: {line}")
-    d = summary["diagnostics"]
+    d = summary.diagnostics
     quality = (f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}" if d.get("rhat_max") is not None
                else f"Pareto k {d.get('pareto_k', float('nan')):.2f}, {d['ess_min']:.0f} effective draws")
-    evidence = summary.get("log_evidence")
+    evidence = summary.log_evidence
     if evidence:
         quality += f", ln Z {evidence['value']:.2f} +- {evidence['error']:.2f}"
     print(f"wrote {args.out}/summary.json, posterior.nc, corner.png, fit.png, residuals.png, residual_trends.png, "
-          f"report.html ({quality}, {summary['seconds']:.1f} s)")
+          f"report.html ({quality}, {summary.seconds:.1f} s)")
     return 0
 
 

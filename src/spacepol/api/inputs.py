@@ -179,3 +179,54 @@ def finite_number(name: str, value, low: float | None = None) -> float:
     if low is not None and number < low:
         raise ParameterError(f"--{name} {number:g}: must be >= {low:g}")
     return number
+
+
+def name_values(items, flag: str) -> list[tuple[str, str]]:
+    """``["n=1.5", ...]`` as (name, text) pairs; an item without a name or '=' is one line naming ``flag``."""
+    pairs = []
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise ParameterError(f"{flag} '{item}': expected NAME=VALUE")
+        pairs.append((name.strip(), text))
+    return pairs
+
+
+def _number_of(flag: str, name: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ParameterError(f"{flag} '{name}={text}': '{text}' is not a number") from None
+
+
+def parse_settings(items, model) -> dict[str, float]:
+    """``--set`` texts (``["n=1.5", "k=0"]``) -> {"n": 1.5, "k": 0.0}, each name and value checked against
+    ``model`` (``parameter_values``)."""
+    values = {}
+    for name, text in name_values(items, "--set"):
+        values[name] = _number_of("--set", name, text)
+        parameter_values(model, {name: values[name]}, where="--set")
+    return values
+
+
+def parse_references(items) -> dict[str, float]:
+    """``--reference`` texts (``["n=1.35"]``) -> {"n": 1.35}; the run checks the names against the model."""
+    return {name: _number_of("--reference", name, text) for name, text in name_values(items, "--reference")}
+
+
+def parse_engine_options(items) -> dict:
+    """``--engine-option`` texts (``["replicates=5", "live=300"]``) -> {"replicates": 5, "live": 300}: whole numbers
+    as int, other numbers as float, true/false as bool, the rest as text; the engine checks the names."""
+    options = {}
+    for name, text in name_values(items, "--engine-option"):
+        value: object = text
+        for convert in (int, float):
+            try:
+                value = convert(text)
+                break
+            except ValueError:
+                continue
+        if text.lower() in ("true", "false"):
+            value = text.lower() == "true"
+        options[name] = value
+    return options

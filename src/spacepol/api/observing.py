@@ -61,7 +61,7 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
     if out is not None:
         from ..report.contrast_report import assumptions, write_contrast_report
 
-        write_contrast_report(content, dict(per_case), out, result.summary["model"],
+        write_contrast_report(content, dict(per_case), out, result.summary.model,
                               assumptions(result.summary, scenario, content["material"]))
     return Contrast(content, per_case)
 

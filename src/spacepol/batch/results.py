@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import math
 
+from ..infer.run_summary import RunSummary
 from ..io.atomic import atomic_path
 
 QUANTITIES = ("median", "q05", "q95")
@@ -15,11 +16,11 @@ QUANTITIES = ("median", "q05", "q95")
 def table_row(outcome: dict) -> dict:
     """Flat CSV fields of one job's outcome (``job.run_job``'s dict, or a skipped set's)."""
     row = {"id": outcome["id"], "status": outcome["status"], "seconds": f"{outcome['seconds']:.1f}"}
-    summary = outcome.get("summary") or {}
-    for name, stats in summary.get("parameters", {}).items():
+    summary = RunSummary.from_json(outcome["summary"]) if outcome.get("summary") else RunSummary(model="")
+    for name, stats in summary.parameters.items():
         for q in QUANTITIES:
             row[f"{name}_{q}"] = _number(stats.get(q))
-    diagnostics = summary.get("diagnostics", {})
+    diagnostics = summary.diagnostics
     row["rhat_max"], row["ess_min"] = _number(diagnostics.get("rhat_max")), _number(diagnostics.get("ess_min"))
     row["error"] = outcome.get("error", "")
     return row

@@ -60,7 +60,7 @@ def _build(data, model, observables, priors, check: bool = True):
 def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, posterior_method: str = "laplace"):
     """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
     Laplace approximation corrected by importance sampling (the registry's ``laplace`` engine), where its checks trust
-    it, else emcee (why not: ``summary["laplace_refused"]``; stopped before convergence where the ELPD-LOO of its
+    it, else emcee (why not: ``summary.laplace_refused``; stopped before convergence where the ELPD-LOO of its
     two halves agree, ``elpd_settled``); "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``,
     ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s
     instead of 39-48 s (``benchmarks/laplace_vs_emcee.py``)."""
@@ -74,7 +74,7 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
     inv = invert(posterior, seed=seed, max_steps=max_steps, progress=False, centre=centre,
                  tau_multiple=ELPD_TAU_MULTIPLE, max_pointwise_draws=ELPD_DRAWS, elpd_tolerance=elpd_settled.TOLERANCE)
     if refusal:  # why emcee: the Laplace approximation's failed checks
-        inv.summary["laplace_refused"] = refusal
+        inv.summary.laplace_refused = refusal
     return inv
 
 
@@ -98,7 +98,7 @@ class DiagnosePosterior(Engine):
         seed = int(rng.integers(2**31))
         _, centre = find_optimum(posterior, np.random.default_rng(seed))
         inv = fit_for_elpd(posterior, centre, seed, self.max_steps)
-        self.ran.append(inv.summary["diagnostics"]["engine"])
+        self.ran.append(inv.summary.diagnostics["engine"])
         return inv.draws
 
 

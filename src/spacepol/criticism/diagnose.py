@@ -24,6 +24,7 @@ from ..physics.registry import registry
 from .candidate_fits import CandidateFits, fit_for_elpd, model_key
 from .changes import BLIND_REASON, blind_changes, changes, separating_measurement, separating_observables
 from .records import CandidateFit, DiagnosisRecord
+from ..infer.run_summary import RunSummary
 
 
 def _first_sentence(text: str) -> str:
@@ -174,7 +175,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
             diff = inv.loo["pointwise"] - base_loo
             c.inversion, c.pointwise = inv, inv.loo["pointwise"]
             c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
-            c.rmse_dop_after, c.signatures = inv.summary["fit"]["rmse_dop"], signatures(base, inv, base_fit)
+            c.rmse_dop_after, c.signatures = inv.summary.fit["rmse_dop"], signatures(base, inv, base_fit)
             c.significant = significant(c.delta_elpd, c.delta_elpd_se)
             refitted.append(c)
             if progress:
@@ -184,7 +185,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                        else f"emcee (the Laplace approximation was not trusted{refused})"
                        + ("" if q["converged"] else f", which {_unconverged(q)}"))
                 _say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {c.label}: {how}, "
-                     f"{inv.summary.get('seconds', 0):.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
+                     f"{inv.summary.seconds:.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
 
     def weigh(pending: list) -> list:
         """``pending`` less those the best refit so far shows clearly worse (``_dominated``; not the changes asked for)."""
@@ -277,11 +278,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                                               f"two are twins here; {sep} would separate them.")
     for entry, c in zip(ranking, confirmed):
         entry["free_parameters"] = c.posterior.ndim
-    return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary["fit"], "base_posterior": posterior_quality(base),
+    return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary.fit, "base_posterior": posterior_quality(base),
             "ranking": ranking, "verdict": verdict,
             "not_screened": [{"change": c.label, "reason": BLIND_REASON} for c in blind],
             "free_parameters": base_post.ndim,
-            "residual_structure": base.summary["residual_structure"]["findings"],
+            "residual_structure": base.summary.residual_structure["findings"],
             "conclusion": _conclusion(base, confirmed, verdict),
             "seconds": {"base_fit": clock["base"] - clock["start"], "screening": clock["screening"] - clock["base"],
                         "confirmation": clock["confirmation"] - clock["screening"],
@@ -311,9 +312,9 @@ def posterior_quality(inv) -> dict:
     if d.engine == "laplace-is":
         return {"engine": d.engine, "converged": True, "pareto_k": d.pareto_k, "effective_draws": d.ess_min}
     quality = {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps,
-               "stopped_early": bool(inv.summary.get("sampler", {}).get("stopped_early", False))}
-    if inv.summary.get("laplace_refused"):
-        quality["laplace_refused"] = inv.summary["laplace_refused"]
+               "stopped_early": bool(inv.summary.sampler.get("stopped_early", False))}
+    if inv.summary.laplace_refused:
+        quality["laplace_refused"] = inv.summary.laplace_refused
     return quality
 
 
@@ -423,7 +424,7 @@ def evidence_of(result, posterior, seed: int) -> tuple[float, float]:
     from ..infer.engine_registry import engines
 
     nested = engines.get("nested").result(posterior, seed=seed)
-    result.summary["log_evidence"] = nested.summary["log_evidence"]
+    result.summary.log_evidence = nested.summary.log_evidence
     return nested.log_evidence
 
 
@@ -439,14 +440,14 @@ def _close(a: float, b: float) -> bool:
     return abs(a - b) < 1.0 + 0.01 * max(abs(a), abs(b))
 
 
-def _structured(summary) -> bool:
+def _structured(summary: RunSummary) -> bool:
     """Residuals still carry structure: runs/trends flagged, or a misfit above the noise floor: with known noise
     chi^2 > 1.5; with inferred noise that the data also measure themselves, an inferred level above 1.5x the
     measured one; with inferred noise alone chi^2 ~ 1 by construction and says nothing."""
-    if summary.get("noise"):  # the data measure their noise: explained only within 1.5x of it
-        return not explains(summary["noise"]) or summary["residual_structure"]["structured"]
-    above_floor = not inferred_noise_levels(summary) and summary["fit"]["chi2_red"] > 1.5
-    return above_floor or summary["residual_structure"]["structured"]
+    if summary.noise:  # the data measure their noise: explained only within 1.5x of it
+        return not explains(summary.noise) or summary.residual_structure["structured"]
+    above_floor = not inferred_noise_levels(summary) and summary.fit["chi2_red"] > 1.5
+    return above_floor or summary.residual_structure["structured"]
 
 
 def _conclusion(base, confirmed, verdict) -> str:
@@ -454,17 +455,17 @@ def _conclusion(base, confirmed, verdict) -> str:
     if verdict == "none":
         if _structured(base.summary):
             return ("No candidate in the library improves ELPD-LOO by more than 2 SE (and 4), yet the residuals of "
-                    f"{base.summary['model']} are structured ({describe_fit(base.summary)}; "
+                    f"{base.summary.model} are structured ({describe_fit(base.summary)}; "
                     "see residual_structure): an effect outside the library is likely. Write it as a plug-in "
                     "effect and rerun diagnose.")
-        return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary['model']} "
+        return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary.model} "
                 "look like noise: nothing is missing at this noise level.")
     lead = next(c for c in confirmed if c.verdict == verdict)
     after = lead.inversion.summary
     text = f"{lead.label[0].upper()}{lead.label[1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
     if _structured(after):
         text += (f" It helps, but does not explain the misfit (partly explained): after it the residuals are still "
-                 f"structured ({describe_fit(after)}; " + " ".join(after["residual_structure"]["findings"])
+                 f"structured ({describe_fit(after)}; " + " ".join(after.residual_structure["findings"])
                  + "). Run diagnose again on the changed model (or use --rounds); if nothing else in the library helps, "
                  "the rest comes from an effect outside it.")
     else:
@@ -504,7 +505,7 @@ def _explain(c: CandidateFit, base) -> str:
         physics = f"Replace {c.change.replaced} by {c.effect}: {physics}"
     elif c.kind == "remove":
         physics = f"Remove {c.effect} ({physics[0].lower()}{physics[1:]})"
-    rmse0, rmse1 = base.summary["fit"]["rmse_dop"], c.rmse_dop_after
+    rmse0, rmse1 = base.summary.fit["rmse_dop"], c.rmse_dop_after
     rmse = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
     noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c.inversion.summary)
     if noise0:
@@ -517,9 +518,9 @@ def _explain(c: CandidateFit, base) -> str:
                   else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
         why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
                    f"correlates {s['correlation']:+.2f} with the residuals and {change}")
-    bounds = [bound_finding(f) for f in c.inversion.summary["identifiability"].get("at_bound", [])]
+    bounds = [bound_finding(f) for f in c.inversion.summary.at_bound]
     if c.significant and _structured(c.inversion.summary):
         bounds.insert(0, "it helps, but does not explain the misfit: after it the residuals are still structured ("
-                      + " ".join(c.inversion.summary["residual_structure"]["findings"]) + ").")
+                      + " ".join(c.inversion.summary.residual_structure["findings"]) + ").")
     return (f"{physics} Adding it changes ELPD-LOO by {c.delta_elpd:+.1f} +- {c.delta_elpd_se:.1f} ({verdict}); "
             f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))

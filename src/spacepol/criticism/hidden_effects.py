@@ -150,7 +150,7 @@ def score(case: Case, report: dict) -> dict:
     confirmed = {c.effect: c for c in report.confirmed if c.kind == "add"}
     if case.effect in confirmed:
         inversion = confirmed[case.effect].inversion
-        out["chi2_red_after"] = inversion.summary["fit"]["chi2_red"]
+        out["chi2_red_after"] = inversion.summary.fit["chi2_red"]
         out["covered"] = covered(case.effect, inversion, case.hidden)
     return out
 

@@ -34,21 +34,21 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
             post = Posterior.build(data, current, observables=observables)
             centre = None
             if rungs:  # start from the previous rung's optimum, the change's new parameters at neutral values
-                seeds = start_points(rungs[-1].inversion.summary["map"], change, post)
+                seeds = start_points(rungs[-1].inversion.summary.map, change, post)
                 centre = find_optimum(post, np.random.default_rng(seed), evaluations=4000, seeds=seeds)[1]
             inv = invert(post, seed=seed, max_steps=max_steps, progress=False, centre=centre)
-        fit, noise = inv.summary["fit"], inferred_noise_levels(inv.summary)
+        fit, noise = inv.summary.fit, inferred_noise_levels(inv.summary)
         evidence = rung_evidence(inv, seed)
         rungs.append(Rung({"model": current.name, "change": None if change is None else change.label,
                       "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"],
                       "log_evidence": None if evidence is None else evidence[0],
                       "log_evidence_error": None if evidence is None else evidence[1],
-                      "inferred_noise": noise, "noise_known": not noise, "noise": inv.summary.get("noise", {}),
-                      "rhat_max": inv.summary["diagnostics"]["rhat_max"],
-                      "pareto_k": inv.summary["diagnostics"].get("pareto_k"), "parameters": inv.summary["parameters"],
-                      "at_bound": inv.summary["identifiability"].get("at_bound", []),
-                      "residual_structure": inv.summary["residual_structure"]["findings"]}, inv))
+                      "inferred_noise": noise, "noise_known": not noise, "noise": inv.summary.noise,
+                      "rhat_max": inv.summary.diagnostics["rhat_max"],
+                      "pareto_k": inv.summary.diagnostics.get("pareto_k"), "parameters": inv.summary.parameters,
+                      "at_bound": inv.summary.at_bound,
+                      "residual_structure": inv.summary.residual_structure["findings"]}, inv))
     return rungs
 
 

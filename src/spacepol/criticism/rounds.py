@@ -15,14 +15,15 @@ from .changes import changes, slot_alternatives
 from .candidate_fits import CandidateFits
 from .diagnose import _structured, diagnose, significant
 from .records import CandidateFit, DiagnosisRecord, RoundsRecord, Rung
+from ..infer.run_summary import RunSummary
 
 
-def _step(summary: dict, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
-    return {"model": summary["model"], "change": change, "delta_elpd": delta, "delta_elpd_se": se, "tied_with": list(tied),
+def _step(summary: RunSummary, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
+    return {"model": summary.model, "change": change, "delta_elpd": delta, "delta_elpd_se": se, "tied_with": list(tied),
             "alternatives": list(alternatives),
-            "fit": summary["fit"], "inferred_noise": inferred_noise_levels(summary), "noise": summary.get("noise", {}),
-            "residual_structure": summary["residual_structure"]["findings"],
-            "structured": bool(_structured(summary)), "at_bound": summary["identifiability"].get("at_bound", [])}
+            "fit": summary.fit, "inferred_noise": inferred_noise_levels(summary), "noise": summary.noise,
+            "residual_structure": summary.residual_structure["findings"],
+            "structured": bool(_structured(summary)), "at_bound": summary.at_bound}
 
 
 def as_rungs(result: RoundsRecord) -> list[Rung]:
@@ -36,8 +37,8 @@ def as_rungs(result: RoundsRecord) -> list[Rung]:
         rungs.append(Rung({"model": step["model"], "change": step["change"], "delta_elpd": step["delta_elpd"],
                       "delta_elpd_se": step["delta_elpd_se"], "rmse_dop": fit["rmse_dop"], "chi2_red": fit["chi2_red"],
                       "elpd_loo": fit["elpd_loo"], "elpd_loo_se": fit["elpd_loo_se"], "inferred_noise": step["inferred_noise"],
-                      "noise": step.get("noise", {}), "structured": step["structured"], "rhat_max": inv.summary["diagnostics"]["rhat_max"],
-                      "pareto_k": inv.summary["diagnostics"].get("pareto_k"),
+                      "noise": step.get("noise", {}), "structured": step["structured"], "rhat_max": inv.summary.diagnostics["rhat_max"],
+                      "pareto_k": inv.summary.diagnostics.get("pareto_k"),
                       "at_bound": step["at_bound"]}, inv))
     return rungs
 

@@ -80,7 +80,7 @@ def contrast_of(result, scenario, seed: int = 0, draws: int = 20000, reading: st
     from ..errors import SpacepolError
     from .paper_table3 import recompute
 
-    samples, spec = result.samples(), result.summary.get("spec", result.summary["model"])
+    samples, spec = result.samples(), result.summary.model_spec
     if isinstance(spec, str) and any("@" in name for name in samples):
         raise SpacepolError("contrast: the run has per-wavelength parameters but its summary.json stores only the model's "
                             "name; run it again with this version to store the whole model")

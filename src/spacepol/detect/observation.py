@@ -230,13 +230,13 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     scenario = default_scenario()
     scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
     inner, params, material = material_samples(result.model, result.samples(), scenario,
-                                               result.summary.get("spec", result.summary["model"]))
+                                               result.summary.model_spec)
     size = max(np.size(v) for v in params.values())
     pick = rng.choice(size, min(draws, size), replace=False)
     chosen = {k: np.asarray(v)[pick] if np.size(v) == size else v for k, v in params.items()}  # fixed values as they are
     if progress:
         print(f"observe: {element_set.name}, {len(geometry.times_utc)} times, {len(faces)} faces, {len(pick)} draws of "
-              f"{result.summary['model']}", file=sys.stderr)
+              f"{result.summary.model}", file=sys.stderr)
     observation = observe_pass(geometry, inner, chosen, camera, band_um, p_false_alarm, sky_magnitude_zenith, p_max,
                                rng=rng, stacked=exposures_per_step, progress=progress)
     assumptions = [
@@ -244,7 +244,7 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
         f"{site[2]:g} m; {len(geometry.times_utc)} times every {step_s:g} s.",
         f"Target: {len(faces)} faces ({', '.join(f'{f.name} {f.area_m2:g} m^2 {f.orientation}' + _material_words(f) for f in faces)}); "
         "shadows between faces and light reflected between them are left out.",
-        f"Material: {len(pick)} draws of the posterior of {result.summary['model']}; {material['rule']}.",
+        f"Material: {len(pick)} draws of the posterior of {result.summary.model}; {material['rule']}.",
         f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um. Sky: CIE clear sky (type 12) scaled to "
         f"{sky_magnitude_zenith:g} mag arcsec^-2 at the zenith (default 5.40, what the paper's Table 3 implies), single "
         f"Rayleigh scattering's polarization with P_max {p_max:g}.",

@@ -11,6 +11,7 @@ from .inference_data import median_fit, model_dop
 from .posterior import Posterior
 from .psis import logsumexp_rows, psis_log_weights
 from .engine_result import EngineResult
+from .run_summary import RunSummary
 
 
 def convergence(idata, result: EngineResult) -> dict:
@@ -118,9 +119,9 @@ def _noise_names() -> tuple[str, ...]:
     return tuple(dict.fromkeys(names))
 
 
-def inferred_noise_levels(summary: dict) -> dict[str, float]:
+def inferred_noise_levels(summary: RunSummary) -> dict[str, float]:
     """{nuisance: posterior median} of the noise levels a run inferred (empty when the file gave errors)."""
-    return {n: summary["parameters"][n]["median"] for n in _noise_names() if n in summary.get("parameters", {})}
+    return {n: summary.parameters[n]["median"] for n in _noise_names() if n in summary.parameters}
 
 
 def fit_words(chi2_red: float, noise: dict[str, float]) -> str:
@@ -131,10 +132,10 @@ def fit_words(chi2_red: float, noise: dict[str, float]) -> str:
     return f"reduced chi^2 {chi2_red:.2f}"
 
 
-def describe_fit(summary: dict) -> str:
+def describe_fit(summary: RunSummary) -> str:
     """``fit_words`` of a run's summary, and where the data measure their own noise, the misfit per group
     (inferred / measured noise)."""
-    return fit_words(summary["fit"]["chi2_red"], inferred_noise_levels(summary)) + misfit_words(summary.get("noise"))
+    return fit_words(summary.fit["chi2_red"], inferred_noise_levels(summary)) + misfit_words(summary.noise)
 
 
 def misfit_words(noise: dict | None) -> str:

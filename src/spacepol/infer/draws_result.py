@@ -15,6 +15,7 @@ from .identifiability import identifiability
 from .inference_data import to_inference_data
 from .posterior import Posterior
 from .result import Result
+from .run_summary import RunSummary
 
 
 def result_of(posterior: Posterior, draws: EngineResult, rng: np.random.Generator, seed: int, start: float,
@@ -29,46 +30,46 @@ def summarised(posterior: Posterior, result: EngineResult, idata, loo_result: di
                start: float) -> Result:
     """The Result of a posterior's draws: summary (quantiles, fit, noise ratios, identifiability, residual
     structure) and the ArviZ groups."""
-    summary = {
-        "model": posterior.likelihood.model.name,
+    summary = RunSummary(
+        model=posterior.likelihood.model.name,
         # the whole model: what contrast rebuilds
-        "spec": spec_of(posterior.likelihood.model, posterior.likelihood.data.wavelength_um),
-        "parameters": quantiles(result),
-        "engine": diagnostics["engine"],  # what drew the posterior (emcee where the Laplace engine was refused)
-        "diagnostics": diagnostics,
-        "fit": fit_statistics(posterior, result, loo_result),
-        "seconds": time.perf_counter() - start,
-        "seed": seed,
-        "observables": posterior.likelihood.observables,
-        "observables_not_fitted": dict(posterior.likelihood.left_out),  # {name: the fitted observable holding it}
+        spec=spec_of(posterior.likelihood.model, posterior.likelihood.data.wavelength_um),
+        parameters=quantiles(result),
+        engine=diagnostics["engine"],  # what drew the posterior (emcee where the Laplace engine was refused)
+        diagnostics=diagnostics,
+        fit=fit_statistics(posterior, result, loo_result),
+        seconds=time.perf_counter() - start,
+        seed=seed,
+        observables=posterior.likelihood.observables,
+        observables_not_fitted=dict(posterior.likelihood.left_out),  # {name: the fitted observable holding it}
         # a user's observable and the file it came from ("path.py:Name", "entry point X")
-        "observable_plugins": {o.name: registry.sources[o.name] for o in posterior.likelihood.objects
-                               if o.name in registry.sources},
-        "n_observations": posterior.likelihood.n_obs,
-        "priors": posterior.priors.describe(),
-        "fixed": {k: float(v) for k, v in posterior.priors.fixed.items()},
-        "map": result.best,
-        "sampler": {k: v for k, v in result.info.items() if k not in ("tau", "start_search")} | {"tau": result.info.get("tau")},
-        "pareto_k_bad": loo_result["pareto_k_bad"],
-    }
+        observable_plugins={o.name: registry.sources[o.name] for o in posterior.likelihood.objects
+                        if o.name in registry.sources},
+        n_observations=posterior.likelihood.n_obs,
+        priors=posterior.priors.describe(),
+        fixed={k: float(v) for k, v in posterior.priors.fixed.items()},
+        map=result.best,
+        sampler={k: v for k, v in result.info.items() if k not in ("tau", "start_search")} | {"tau": result.info.get("tau")},
+        pareto_k_bad=loo_result["pareto_k_bad"],
+    )
     if "log_evidence" in result.info:  # an engine that estimates the evidence (nested sampling, Laplace-IS)
-        summary["log_evidence"] = {"value": float(result.info["log_evidence"]),
-                                   "error": float(result.info.get("log_evidence_error", np.nan))}
+        summary.log_evidence = {"value": float(result.info["log_evidence"]),
+                               "error": float(result.info.get("log_evidence_error", np.nan))}
     if "start_search" in result.info:  # the modes the start-point searches found (infer.modes)
-        summary["start_search"] = result.info["start_search"]
-    noise = noise_ratios(posterior, summary["parameters"])
+        summary.start_search = result.info["start_search"]
+    noise = noise_ratios(posterior, summary.parameters)
     if noise:
-        summary["noise"] = noise
+        summary.noise = noise
     derived = getattr(posterior.likelihood.model, "derived", None)
     if derived is not None:  # values a dispersion law implies per wavelength (n@0.633 from A and B)
         values = derived(posterior.priors.to_params(result.flat_samples()))
-        summary["derived"] = {name: quantile_dict(np.asarray(v, float).ravel()) for name, v in values.items()}
+        summary.derived = {name: quantile_dict(np.asarray(v, float).ravel()) for name, v in values.items()}
     ident = identifiability(posterior, result)
-    summary["identifiability"] = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
+    summary.identifiability = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
     from .residuals import analyse
 
     structure = analyse(posterior, result.flat_samples())
-    summary["residual_structure"] = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
+    summary.residual_structure = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
                                      "structured": structure.structured()}
     return Result(posterior, result, idata, summary, loo_result, ident)
 

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import SpacepolError
 from .engine_result import EngineResult
 from .engine_result import ESS_TARGET, RHAT_TARGET
+from .run_summary import RunSummary
 
 SUMMARY_FILE = "summary.json"
 POSTERIOR_FILE = "posterior.nc"
@@ -74,35 +75,35 @@ class Result:
     posterior: object | None
     draws: EngineResult
     idata: object
-    summary: dict
+    summary: RunSummary
     loo: dict
     identifiability: dict
 
     @property
     def engine(self) -> str:
         """The engine that made the draws (emcee, laplace-is, nuts, ...)."""
-        return self.summary.get("diagnostics", {}).get("engine") or self.draws.method
+        return self.summary.engine_ran or self.draws.method
 
     @property
     def engine_settings(self) -> dict:
         """The engine's own settings and run figures (walkers, steps, burn-in, thinning, ...)."""
-        return dict(self.summary.get("sampler", {}))
+        return dict(self.summary.sampler)
 
     @property
     def seed(self) -> int:
         """The seed of the one Generator the run used."""
-        return int(self.summary["seed"])
+        return int(self.summary.seed)
 
     @property
     def spec(self) -> dict:
         """The whole model: effects, plug-in sources, wavelengths, dispersion (``physics.model_spec``), and the
         observables fitted (the channels; a user's observable with its source) and the priors used."""
-        spec = self.summary.get("spec", self.summary["model"])
+        spec = self.summary.model_spec
         spec = {"effects": spec, "plugins": {}, "wavelengths_um": None, "dispersion": {}} if isinstance(spec, str) else spec
-        return {**spec, "observables": list(self.summary.get("observables", [])),
-                "observable_plugins": dict(self.summary.get("observable_plugins", {})),
-                "priors": dict(self.summary.get("priors", {})),
-                "fixed": dict(self.summary.get("fixed", {}))}
+        return {**spec, "observables": list(self.summary.observables),
+                "observable_plugins": dict(self.summary.observable_plugins),
+                "priors": dict(self.summary.priors),
+                "fixed": dict(self.summary.fixed)}
 
     @property
     def model(self):
@@ -111,18 +112,18 @@ class Result:
             return self.posterior.likelihood.model
         from ..physics.model_spec import model_from_spec
 
-        return model_from_spec(self.summary.get("spec", self.summary["model"]))
+        return model_from_spec(self.summary.model_spec)
 
     @property
     def log_evidence(self) -> tuple[float, float] | None:
         """(ln Z, its standard error) when the engine estimates the evidence (a nested sampler), else None."""
-        value = self.summary.get("log_evidence")
+        value = self.summary.log_evidence
         return None if value is None else (float(value["value"]), float(value["error"]))
 
     @property
     def diagnostics(self) -> Diagnostics:
         """Convergence or importance-weight diagnostics, typed."""
-        d, sampler = self.summary.get("diagnostics", {}), self.summary.get("sampler", {})
+        d, sampler = self.summary.diagnostics, self.summary.sampler
         engine = d.get("engine") or "emcee"
         capped = bool(sampler.get("capped", False))
         if engine == "laplace-is":
@@ -139,17 +140,17 @@ class Result:
     @property
     def fit(self) -> Fit:
         """Fit statistics, typed."""
-        f = self.summary["fit"]
+        f = self.summary.fit
         return Fit(chi2_red=float(f["chi2_red"]), rmse_dop=f.get("rmse_dop"), elpd_loo=float(f["elpd_loo"]),
                    elpd_loo_se=float(f["elpd_loo_se"]),
-                   misfit={k: float(v["ratio"]) for k, v in self.summary.get("noise", {}).items()})
+                   misfit={k: float(v["ratio"]) for k, v in self.summary.noise.items()})
 
     def samples(self, include_fixed: bool = True) -> dict[str, np.ndarray]:
         """{parameter: flat draws} of every free parameter; fixed parameters as 0-d arrays when ``include_fixed``."""
         flat = self.draws.flat_samples()
         out = {name: flat[:, j] for j, name in enumerate(self.draws.names)}
         if include_fixed:
-            for name, value in self.summary.get("fixed", {}).items():
+            for name, value in self.summary.fixed.items():
                 out.setdefault(name, np.asarray(float(value)))
         return out
 
@@ -160,7 +161,7 @@ class Result:
     def to_json(self) -> dict:
         """summary.json's content (its fixed fields: model, spec, parameters, diagnostics, fit, seconds, seed,
         observables, priors, fixed, map, sampler, identifiability)."""
-        return self.summary
+        return self.summary.to_json()
 
     def save(self, folder) -> Path:
         """Write ``posterior.nc`` (ArviZ groups, the pointwise ones thinned for storage) and ``summary.json`` into
@@ -172,7 +173,7 @@ class Result:
         folder.mkdir(parents=True, exist_ok=True)
         with atomic_path(folder / POSTERIOR_FILE) as tmp:
             for_storage(self.idata).to_netcdf(str(tmp))
-        write_json(folder / SUMMARY_FILE, self.summary)
+        write_json(folder / SUMMARY_FILE, self.summary.to_json())
         return folder
 
     @classmethod
@@ -189,11 +190,10 @@ class Result:
             if not path.is_file():
                 raise SpacepolError(f"{path}: missing; is {folder} the output folder of `invert-mcmc run`?")
         try:
-            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+            content = json.loads(summary_path.read_text(encoding="utf-8"))
         except (json.JSONDecodeError, UnicodeDecodeError):
-            summary = None
-        if not isinstance(summary, dict) or "model" not in summary:
-            raise SpacepolError(f"{summary_path}: not a spacepol summary (no 'model')")
+            content = None
+        summary = RunSummary.from_json(content, str(summary_path))
         try:
             idata = az.from_netcdf(str(posterior_path))
             post = idata.posterior
@@ -204,11 +204,11 @@ class Result:
         log_prob = (np.asarray(idata.sample_stats["lp"]).T if "sample_stats" in idata.groups()
                     and "lp" in idata.sample_stats else None)
         attrs = post.attrs
-        draws = EngineResult(method=str(attrs.get("method", summary.get("diagnostics", {}).get("engine", "emcee"))),
-                             model=summary["model"], names=names, best=dict(summary.get("map", {})),
+        draws = EngineResult(method=str(attrs.get("method", summary.diagnostics.get("engine", "emcee"))),
+                             model=summary.model, names=names, best=dict(summary.map),
                              objective=np.nan, objective_name="negative_log_posterior", n_evaluations=0,
-                             seconds=float(summary.get("seconds", 0.0)), seed=int(summary.get("seed", -1)),
-                             samples=samples, log_prob=log_prob, info=dict(summary.get("sampler", {})))
+                             seconds=float(summary.seconds), seed=int(summary.seed),
+                             samples=samples, log_prob=log_prob, info=dict(summary.sampler))
         return cls(posterior=None, draws=draws, idata=idata, summary=summary,
-                   loo={k: summary["fit"][k] for k in ("elpd_loo", "elpd_loo_se")} if "fit" in summary else {},
-                   identifiability=dict(summary.get("identifiability", {})))
+                   loo={k: summary.fit[k] for k in ("elpd_loo", "elpd_loo_se")} if summary.fit else {},
+                   identifiability=dict(summary.identifiability))

@@ -64,7 +64,7 @@ def run_comparison(posterior, data, out: Path, methods=None, seeds: int = 3, bas
         r["success"] = bool(r["objective"] <= best_known * (1 + rtol) + 1e-12)
     interval = {}
     if inv is not None:
-        interval = {n: [q["q05"], q["q95"]] for n, q in inv.summary["parameters"].items()}
+        interval = {n: [q["q05"], q["q95"]] for n, q in inv.summary.parameters.items()}
     table = _table(runs, methods, objective.names)
     report = {"objective": objective.name, "best_known": best_known, "success_rtol": rtol,
               "posterior_90": interval, "methods": table,

@@ -7,6 +7,7 @@ from pathlib import Path
 from ..io.atomic import atomic_path, save_figure, write_json
 from . import html as H
 from .sky_figures import contrast_histograms
+from ..infer.run_summary import RunSummary
 
 QUANTITIES = [("target_dop", "target DOP", "{:.3f}"), ("sky_dop", "sky DOP", "{:.3f}"),
               ("limiting_magnitude", "limiting magnitude", "{:.2f}"), ("intensity_contrast", "raw intensity contrast", "{:.4f}"),
@@ -45,16 +46,16 @@ def make_contrast_report(result, scenario, out: Path, reading: str = "corrected"
     from ..detect.contrast import contrast_of
 
     report, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
-    write_contrast_report(report, per_case, out, label or result.summary["model"],
+    write_contrast_report(report, per_case, out, label or result.summary.model,
                           assumptions(result.summary, scenario, report["material"]))
     return report
 
 
-def assumptions(summary: dict, scenario, material: dict | None = None) -> list[str]:
+def assumptions(summary: RunSummary, scenario, material: dict | None = None) -> list[str]:
     """What the contrast assumed (geometry, material rule, sky model, radiometry), one sentence each."""
     t, sky_ = scenario.target, scenario.sky
     return [
-        f"Target DOP from the posterior of {summary['model']} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "
+        f"Target DOP from the posterior of {summary.model} at theta_i {t['theta_i_deg']:g} deg, dphi {t['dphi_deg']:g} deg, "
         f"theta_r uniform in [{t['theta_r_low_deg']:g}, {t['theta_r_high_deg']:g}] deg (the paper's Figure 9 range), "
         "unless a case fixes theta_r_deg.",
         f"Material at {material['wavelength_um']:g} um: {material['rule']}." if material else

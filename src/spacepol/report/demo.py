@@ -32,6 +32,7 @@ from .diagnose_report import significance_statement, write_diagnose_report
 from .sky_figures import projection_distortion_figure, sky_maps_figure
 from .ladder_report import write_ladder_report
 from .run_report import write_run_report
+from ..infer.run_summary import RunSummary
 
 # Sintered PTFE: bulk index ~1.35, non-absorbing, very rough, mostly volume scattering.
 PTFE_GUESS = {"n": 1.35, "k": 0.0, "sigma": 0.35, "ks": 0.08, "rho_d": 1.0}
@@ -90,7 +91,7 @@ def criticise(data, base, out: Path, label: str, seed: int, max_additions: int =
             except SpacepolError:
                 continue
             additions.append(r["change"])
-    fitted = {base.summary["model"]: base} | {c.inversion.summary["model"]: c.inversion for c in confirmed}
+    fitted = {base.summary.model: base} | {c.inversion.summary.model: c.inversion for c in confirmed}
     rungs = climb(data, model, additions, seed=seed, fitted=fitted)
     write_ladder_report(rungs, out / "ladder")
     return report, rungs
@@ -119,10 +120,10 @@ def _criticism_section(report, rungs, folder: str) -> str:
             + f'<p><a href="{Path(folder).name}/diagnose/report.html">Full diagnosis</a></p>')
 
 
-def _noise_words(summary) -> str:
+def _noise_words(summary: RunSummary) -> str:
     """'sigma_m_pol 0.0075, ..., sigma_brdf_rel 32 %': the inferred noise levels, medians."""
     words = []
-    for name, q in summary["parameters"].items():
+    for name, q in summary.parameters.items():
         if name.startswith("sigma_"):
             words.append(f"{name} {100 * q['median']:.0f} %" if name.endswith("_rel") else f"{name} {q['median']:.4f}")
     return ", ".join(words) or "none (the file gives errors)"
@@ -188,8 +189,8 @@ def run_demo(out: Path, seed: int = 0) -> None:
     posterior = Posterior.build(data, Model.from_string("paper"))
     inv = invert(posterior, seed=seed, backend_path=None, progress=True)
     summary = write_run_report(inv, out / "ptfe_paper", f"{source} (0.633 um, in-plane)", references={"n": PTFE_INDEX})
-    n = summary["parameters"]["n"]
-    d = summary["diagnostics"]
+    n = summary.parameters["n"]
+    d = summary.diagnostics
     print(f"   n = {n['median']:.3f} [90 %: {n['q05']:.3f}, {n['q95']:.3f}] against PTFE's bulk index {PTFE_INDEX}; "
           f"R-hat max {d['rhat_max']:.4f}, ESS min {d['ess_min']:.0f}")
 
@@ -244,8 +245,8 @@ def run_demo(out: Path, seed: int = 0) -> None:
             [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
              f"ESS min {d['ess_min']:.0f}; inferred noise: {_noise_words(summary)} (with inferred noise, reduced "
              f"chi^2 is ~1 by construction)."]
-            + [summary["references"]["n"]["explanation"]] + summary["residual_structure"]["findings"]
-            + summary["identifiability"]["findings"])
+            + [summary.references["n"]["explanation"]] + summary.residual_structure["findings"]
+            + summary.identifiability["findings"])
          + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'
          + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),
                    "Residuals: the BRDF's U shape is the paper's cos(theta_r) body term failing a nearly Lambertian "

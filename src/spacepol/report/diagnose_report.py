@@ -12,11 +12,12 @@ from ..infer.residuals import analyse
 from .criticism_figures import ladder_figure, residual_trends_figure, signature_figure
 from .ladder_report import ladder_table
 from .inversion_figures import residual_figure
+from ..infer.run_summary import RunSummary
 
 
-def pareto_warnings(summary: dict) -> list[str]:
+def pareto_warnings(summary: RunSummary) -> list[str]:
     """Sentences for the fits whose PSIS-LOO has observations with Pareto k above 0.7."""
-    bad = summary.get("pareto_k_bad", [])
+    bad = summary.pareto_k_bad
     if not bad:
         return []
     return [f"PSIS-LOO is unreliable (Pareto k > 0.7) at {len(bad)} point(s), where the fit hinges on single "
@@ -90,7 +91,7 @@ def write_diagnose_report(report: dict, base, confirmed: list, out: Path, data_l
             f"{data_label}; base model {report['model']}: RMSE(DOP) {fit['rmse_dop'] if fit['rmse_dop'] is None else round(fit['rmse_dop'], 5)}, "
             f"{describe_fit(base.summary)}, ELPD-LOO {fit['elpd_loo']:.1f} +- {fit['elpd_loo_se']:.1f}.")
          + H.bullets(report["residual_structure"] + pareto_warnings(base.summary)
-                     + [bound_finding(f) for f in base.summary["identifiability"].get("at_bound", [])])),
+                     + [bound_finding(f) for f in base.summary.at_bound])),
         ("Verdict", H.paragraph(f"verdict: {report['verdict']}. " + report["conclusion"]) + H.paragraph(significance_statement(report))),
         ("Ranking", H.table(["change", "screening gain (max log posterior)", "delta ELPD-LOO +- SE", "RMSE(DOP) after",
                              "significant (> 2 SE and > 4)"], ranking_rows(report))

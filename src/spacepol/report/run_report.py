@@ -56,8 +56,8 @@ def write_run_report(inv, out: Path, data_path: str, notes: list[str] | None = N
     out.mkdir(parents=True, exist_ok=True)
     posterior, result, summary = inv.posterior, inv.draws, inv.summary
     if references:
-        summary["references"] = compare_with_references(result, references)
-        notes = list(notes or []) + [r["explanation"] for r in summary["references"].values()]
+        summary.references = compare_with_references(result, references)
+        notes = list(notes or []) + [r["explanation"] for r in summary.references.values()]
     truths = truths_from_metadata(posterior.likelihood.data.metadata)
     figures = {
         "corner.png": corner_figure(result, truths),
@@ -79,16 +79,16 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
         return H.png_file_to_data_uri(out / name)
 
     s = inv.summary
-    diag, fit = s["diagnostics"], s["fit"]
+    diag, fit = s.diagnostics, s.fit
     rows = []
-    for name, q in s["parameters"].items():
+    for name, q in s.parameters.items():
         truth = truths.get(name)
-        flagged = any(f["parameter"] == name for f in s["identifiability"].get("at_bound", []))
+        flagged = any(f["parameter"] == name for f in s.at_bound)
         chain = diag.get("per_parameter", {}).get(name)  # None for importance-weighted draws (no chains)
         rows.append([name + (" (at a bound)" if flagged else ""), f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]", f"[{q['q16']:.4g}, {q['q84']:.4g}]",
                      f"{chain['rhat']:.4f}" if chain else "n/a", f"{chain['ess_bulk']:.0f}" if chain else "n/a",
-                     "" if truth is None else f"{truth:.4g}", s["priors"].get(name, "")])
-    for name, q in s.get("derived", {}).items():  # implied by a dispersion law, not sampled themselves
+                     "" if truth is None else f"{truth:.4g}", s.priors.get(name, "")])
+    for name, q in s.derived.items():  # implied by a dispersion law, not sampled themselves
         rows.append([f"{name} (from the dispersion law)", f"{q['median']:.4g}", f"[{q['q05']:.4g}, {q['q95']:.4g}]",
                      f"[{q['q16']:.4g}, {q['q84']:.4g}]", "", "", "" if truths.get(name) is None else f"{truths[name]:.4g}", ""])
     quality = inv.diagnostics
@@ -100,35 +100,35 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
         verdict = (f"Converged ({quality.engine}): R-hat <= 1.01 and ESS >= 400 for every parameter." if converged else
                    "NOT converged by the R-hat <= 1.01 / ESS >= 400 standard; run longer (--steps) before trusting "
                    "the intervals.")
-    if s.get("laplace_refused"):
-        verdict = f"The Laplace approximation was refused ({s['laplace_refused']}); emcee sampled instead. " + verdict
-    if s.get("log_evidence"):
-        verdict += f" Log evidence ln Z = {s['log_evidence']['value']:.2f} +- {s['log_evidence']['error']:.2f}."
-    if s["sampler"].get("missed_mode"):
-        verdict += f" NOT the whole posterior: {s['sampler']['missed_mode']['finding']}."
-    if s["sampler"].get("capped"):
-        verdict += f" The chain hit the step cap ({s['sampler']['steps']} steps) before reaching 50 autocorrelation times."
+    if s.laplace_refused:
+        verdict = f"The Laplace approximation was refused ({s.laplace_refused}); emcee sampled instead. " + verdict
+    if s.log_evidence:
+        verdict += f" Log evidence ln Z = {s.log_evidence['value']:.2f} +- {s.log_evidence['error']:.2f}."
+    if s.sampler.get("missed_mode"):
+        verdict += f" NOT the whole posterior: {s.sampler['missed_mode']['finding']}."
+    if s.sampler.get("capped"):
+        verdict += f" The chain hit the step cap ({s.sampler['steps']} steps) before reaching 50 autocorrelation times."
     sections = [
         ("Data and model", H.paragraph(
-            f"{data_path}: {s['n_observations']} observations ({', '.join(s['observables'])}); model {s['model']}; "
-            f"seed {s['seed']}; {s['seconds']:.1f} s.")),
+            f"{data_path}: {s.n_observations} observations ({', '.join(s.observables)}); model {s.model}; "
+            f"seed {s.seed}; {s.seconds:.1f} s.")),
         ("Parameters", H.table(["parameter", "median", "90 % interval", "68 % interval", "R-hat", "ESS bulk", "truth", "prior"], rows)
-         + (H.bullets([bound_finding(f) for f in s["identifiability"].get("at_bound", [])]))),
+         + (H.bullets([bound_finding(f) for f in s.at_bound]))),
         ("Convergence", H.paragraph(verdict) + H.table(
             ["R-hat max", "ESS min (bulk/tail)", "tau max (steps)", "acceptance", "walkers", "steps", "burn-in", "thin"],
             [[_fmt(quality.rhat_max, "{:.4f}"), _fmt(quality.ess_min, "{:.0f}"), _fmt(quality.tau_max, "{:.1f}"),
-              _fmt(diag.get("acceptance"), "{:.2f}"), *(s["sampler"].get(k, "n/a") for k in ("walkers", "steps", "burn_in", "thin"))]])),
-        ("What the data determine", H.bullets(s["identifiability"]["findings"])
-         + (H.paragraph("Where the chain started:") + H.bullets(s["start_search"]["findings"])
-            if s.get("start_search", {}).get("findings") else "")),
+              _fmt(diag.get("acceptance"), "{:.2f}"), *(s.sampler.get(k, "n/a") for k in ("walkers", "steps", "burn_in", "thin"))]])),
+        ("What the data determine", H.bullets(s.identifiability["findings"])
+         + (H.paragraph("Where the chain started:") + H.bullets(s.start_search["findings"])
+            if s.start_search.get("findings") else "")),
         ("Fit", H.table(["RMSE (DOP)", "reduced chi^2", "ELPD-LOO", "SE"],
                         [[_fmt(fit["rmse_dop"]), f"{fit['chi2_red']:.3f}", f"{fit['elpd_loo']:.2f}", f"{fit['elpd_loo_se']:.2f}"]])
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
-                        + ", ".join(s["pareto_k_bad"])) if s["pareto_k_bad"] else "")
-         + H.bullets(s["residual_structure"]["findings"])
+                        + ", ".join(s.pareto_k_bad)) if s.pareto_k_bad else "")
+         + H.bullets(s.residual_structure["findings"])
          + (H.paragraph("Noise the data measure themselves (reciprocal pairs, repeated geometries) against the noise the "
                         "fit inferred; a model explains the data only where the ratio is at most "
-                        f"{EXPLAINED_NOISE_RATIO:g}:") + H.bullets(noise_findings(s["noise"])) if s.get("noise") else "")
+                        f"{EXPLAINED_NOISE_RATIO:g}:") + H.bullets(noise_findings(s.noise)) if s.noise else "")
          + H.image(png("fit.png"), "Data, posterior median and 90 % band of the prediction, "
                    "per observable (rows) and incidence angle (columns).")
          + H.image(png("residuals.png"), "Standardised residuals; dotted lines at +-2.")
@@ -140,7 +140,7 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
     ]
     if notes:
         sections.insert(4, ("Notes", H.bullets(notes)))
-    return H.page(f"spacepol inversion: {s['model']}", sections)
+    return H.page(f"spacepol inversion: {s.model}", sections)
 
 
 def _fmt(x, pattern: str = "{:.4g}"):

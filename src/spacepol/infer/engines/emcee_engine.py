@@ -77,7 +77,7 @@ def invert(posterior: Posterior, seed: int = 0, walkers: int | None = None, max_
     enough at this many autocorrelation times (with R-hat <= 1.01 and ESS >= 400 besides).
     ``max_pointwise_draws``: PSIS-LOO and the posterior predictive from at most this many draws. ``elpd_tolerance``:
     for a caller that needs the ELPD-LOO alone (diagnose), the chain may stop before convergence where the ELPD-LOO
-    of its two halves agree within this many log units (``elpd_settled``; ``summary["sampler"]["stopped_early"]``)."""
+    of its two halves agree within this many log units (``elpd_settled``; ``summary.sampler["stopped_early"]``)."""
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
     walkers = check_walkers(walkers, posterior.ndim)

@@ -25,7 +25,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     PSIS-LOO that accounts for the approximation. None where the approximation cannot be trusted (Pareto k > 0.7,
     fewer than 400 effective draws, weights collapsed onto the mode, emcee walkers started inside the draws spreading
     beyond them (``spread_check``), no negative definite Hessian): the caller samples
-    with emcee (``invert``); ``laplace_fit`` says why. ``summary["diagnostics"]`` holds the weights' Pareto k and
+    with emcee (``invert``); ``laplace_fit`` says why. ``summary.diagnostics`` holds the weights' Pareto k and
     effective draws; R-hat and tau do not apply."""
     return laplace_fit(posterior, centre, seed, draws)[0]
 
@@ -76,7 +76,7 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
 class Laplace(Engine):
     """A Laplace approximation at the posterior's optimum, corrected by importance sampling; where its checks refuse
     it (Pareto k, effective draws, width, the walkers' spread), emcee samples instead and the Result says so
-    (``summary["diagnostics"]["engine"]`` names what ran, ``summary["laplace_refused"]`` why)."""
+    (``summary.diagnostics["engine"]`` names what ran, ``summary.laplace_refused`` why)."""
 
     name, kind, resumable = "laplace", SAMPLER, True  # its emcee fallback keeps its chain, so an interrupted run continues
     description = "Laplace approximation at the optimum corrected by importance sampling; emcee where it cannot be trusted"
@@ -104,7 +104,7 @@ class Laplace(Engine):
             print(f"  the Laplace approximation cannot be trusted here ({refusal}): sampling with emcee",
                   file=sys.stderr, flush=True)
         result = invert(posterior, seed=seed, progress=progress, centre=centre, backend_path=chain)
-        result.summary["laplace_refused"] = refusal
+        result.summary.laplace_refused = refusal
         return result
 
     def check_chain(self, chain, posterior, seed: int, **_) -> None:

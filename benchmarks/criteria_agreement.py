@@ -52,7 +52,8 @@ def main():
     configure_process(small_calls=True)
     from matplotlib.figure import Figure
 
-    from spacepol.criticism.diagnose import diagnose, significant, significant_evidence
+    from spacepol.criticism.criteria import significant, significant_evidence
+    from spacepol.criticism.diagnose import diagnose
     from spacepol.criticism.hidden_effects import BASE, measurement, suite
     from spacepol.physics import Model
 

@@ -195,7 +195,7 @@ def test_refits_asked_for_are_skipped_only_where_the_optima_already_decide(monke
 def test_a_refit_whose_chain_did_not_converge_is_said_so():
     """``posterior_quality``: trusted importance weights, a converged chain, and (the case diagnose must not hide) a
     chain stopped by its cap before R-hat and ESS reached their targets."""
-    from spacepol.criticism.diagnose import posterior_quality
+    from spacepol.criticism.explain import posterior_quality
     from spacepol.infer.engine_result import EngineResult
     from spacepol.infer.result import Result
     from spacepol.infer.run_summary import RunSummary

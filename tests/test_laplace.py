@@ -177,7 +177,7 @@ def test_weights_collapsed_onto_the_mode_of_a_ridge_are_refused():
     result, refusal = laplace_fit(ridge, centre, seed=2)
     assert result is None and refusal == sample.refusal and "collapsed onto the mode" in refusal, refusal
     from spacepol.criticism.candidate_fits import fit_for_elpd
-    from spacepol.criticism.diagnose import posterior_quality
+    from spacepol.criticism.explain import posterior_quality
 
     fallback = posterior_quality(fit_for_elpd(ridge, centre, seed=2, max_steps=500))
     assert fallback["engine"] == "emcee" and fallback["laplace_refused"] == refusal

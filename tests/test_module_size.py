@@ -9,8 +9,6 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src" / "spacepol"
 MODULE_LINES, FUNCTION_LINES = 400, 80
 STILL_LONG = {
-    "criticism/diagnose.py",  # diagnose() as a pipeline of screen -> select -> refit -> rank -> explain
-    "criticism/diagnose.py:diagnose",
     "infer/engines/emcee_sampler.py:sample_emcee",
     "infer/likelihood.py:function",
     "report/demo.py:run_demo",

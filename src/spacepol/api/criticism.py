@@ -55,7 +55,7 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
     ``wavelength_um`` and ``in_plane`` as ``load`` reads it. ``workers``: candidates searched and refitted at once,
     each in its own process (the answer does not depend on it). ``criterion``: ``loo`` (delta ELPD-LOO) or
     ``evidence`` (ln Bayes factor) ranks the refitted changes; each entry holds both where both are known."""
-    from ..criticism.diagnose import CRITERIA
+    from ..criticism.criteria import CRITERIA
     from ..criticism.diagnose import diagnose as run_diagnose
     from ..io.output import check_output_dir, check_output_file
     from ..physics.registry import registry

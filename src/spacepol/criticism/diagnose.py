@@ -5,30 +5,24 @@ The reasoning behind it, and what was measured: the internals page of the docume
 
 from __future__ import annotations
 
-import re
 import sys
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import SpacepolError
-from ..infer import elpd_settled
-from ..infer.diagnostics import describe_fit, inferred_noise_levels
-from ..infer.identifiability import bound_finding
 from ..infer.inference_data import median_fit
-from ..infer.draws_result import explains
 from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
 from .candidate_fits import CandidateFits, fit_for_elpd, model_key
-from .changes import BLIND_REASON, blind_changes, changes, separating_measurement, separating_observables
+from .changes import BLIND_REASON, blind_changes, changes, separating_observables
+from .criteria import CRITERIA, CRITERION, MIN_DELTA_ELPD, Criterion, significant
+from .explain import (conclusion, posterior_quality, posterior_words, refitted_entry, signatures, tie_words,
+                      tied, unrefitted_entry)
 from .records import CandidateFit, DiagnosisRecord
-from ..infer.run_summary import RunSummary
-
-
-def _first_sentence(text: str) -> str:
-    return re.split(r"(?<!et al)(?<!e\.g)(?<!i\.e)\.\s+(?=[A-Z])", text)[0].rstrip(".") + "."
 
 
 def check_prior_names(data, model: Model, priors: dict, observables=None, candidates=None) -> None:
@@ -50,6 +44,40 @@ def _vector(values: dict, posterior) -> np.ndarray:
     return np.array([values[n] for n in posterior.priors.names], float)
 
 
+@dataclass
+class _Run:
+    """What the stages of one diagnosis share: the settings, the shared fits, the base model's posterior, fit and
+    optimum, and the clock."""
+
+    data: object
+    fits: CandidateFits
+    rng: np.random.Generator
+    seed: int
+    progress: bool
+    max_steps: int
+    posterior_method: str
+    confirm: tuple
+    criterion: Criterion
+    searched: dict
+    screening_evaluations: int
+    clock: dict
+    base_post: Posterior = None
+    base: object = None
+    base_best: float = 0.0
+    base_optimum: dict = None
+    blind: list = field(default_factory=list)
+
+    def say(self, text: str) -> None:
+        """A progress line with the seconds since the start, where progress is on."""
+        if self.progress:
+            _say(f"{text} ({time.perf_counter() - self.clock['start']:.0f} s)")
+
+    @property
+    def base_loo(self) -> np.ndarray:
+        """The base fit's pointwise ELPD-LOO."""
+        return self.base.loo["pointwise"]
+
+
 def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observables=None, candidates=None,
              top: int = 3, screening_evaluations: int = 4000, max_steps: int = 8000, progress: bool = True,
              priors: dict | None = None, base=None, confirm=(), simplifications: int = 0,
@@ -68,8 +96,11 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     keeps one for all its rounds), else one is opened and closed here; ``criterion``: what ranks the refitted
     changes and calls them significant, ``loo`` (delta ELPD-LOO > 2 SE and > 4) or ``evidence`` (ln Bayes factor
     > 3 and > 2 x its error; ln Z from Laplace-IS where trusted, else nested sampling). Each ranking entry holds
-    both differences where both are known."""
-    if criterion not in CRITERIA:
+    both differences where both are known.
+
+    A pipeline: the base fit (``_fit_base``), then ``_screen`` -> ``_select`` -> ``_refit`` -> ``_rank`` ->
+    ``_explain``."""
+    if criterion not in CRITERION:
         raise SpacepolError(f"--criterion {criterion}: unknown ({', '.join(CRITERIA)})")
     if fits is None:
         with CandidateFits(data, observables, priors, workers) as own:
@@ -78,121 +109,133 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
                             priors=priors, base=base, confirm=confirm, simplifications=simplifications,
                             posterior_method=posterior_method, searched=searched, fits=own, criterion=criterion)
     check_prior_names(data, model, priors, observables, candidates)
-    clock = {"start": time.perf_counter()}
-    searched = {} if searched is None else searched
-    base_post = fits.posterior(model)
-    if _same_posterior(base, base_post):  # compiled already (diagnose --rounds: the last round's lead)
-        base_post = base.posterior
-    base_post.ensure_checked()
-    if model_key(model) not in searched:
-        searched[model_key(model)] = _global_optimum(base_post, rng, screening_evaluations)
-    base_best, base_optimum = searched[model_key(model)]
-    all_candidates = changes(model, data, candidates)
-    # changes the fitted observables cannot see (a DOP estimator's bias on Mueller data) are not screened
-    blind = blind_changes(all_candidates, base_post.likelihood.objects)
-    all_candidates = [c for c in all_candidates if c not in blind]
-    if base is None:
-        if progress:
-            _say(f"[base] fitting {model.name} ({len(data)} geometries) ...")
-        base = fit_for_elpd(base_post, _vector(base_optimum, base_post), seed, max_steps, posterior_method)
-    base_loo = base.loo["pointwise"]
-    base_fit = median_fit(base.posterior, base.draws.flat_samples())
-    clock["base"] = time.perf_counter()
+    run = _Run(data, fits, rng, seed, progress, max_steps, posterior_method, tuple(confirm), CRITERION[criterion],
+               {} if searched is None else searched, screening_evaluations, {"start": time.perf_counter()})
+    all_candidates = _fit_base(run, model, base, candidates)
+    screened = _screen(run, all_candidates)
+    to_confirm = _select(run, screened, top, simplifications)
+    confirmed = _refit(run, to_confirm)
+    return _explain(run, model, screened, _rank(run, confirmed))
 
-    if progress:
-        _say(f"[base] done in {clock['base'] - clock['start']:.0f} s; screening {len(all_candidates)} candidate effects")
-        if blind:
-            _say(f"[screen] not screened: {', '.join(c.label for c in blind)} ({BLIND_REASON})")
-    posteriors = [fits.posterior(change.model) for change in all_candidates]
-    unsearched = [i for i, change in enumerate(all_candidates) if model_key(change.model) not in searched]
+
+def _fit_base(run: _Run, model: Model, base, candidates) -> list:
+    """The base model's optimum (searched once per model and priors) and fit (``base`` where given); the changes to
+    screen, those the fitted observables cannot see set aside in ``run.blind``."""
+    run.base_post = run.fits.posterior(model)
+    if _same_posterior(base, run.base_post):  # compiled already (diagnose --rounds: the last round's lead)
+        run.base_post = base.posterior
+    run.base_post.ensure_checked()
+    if model_key(model) not in run.searched:
+        run.searched[model_key(model)] = _global_optimum(run.base_post, run.rng, run.screening_evaluations)
+    run.base_best, run.base_optimum = run.searched[model_key(model)]
+    all_candidates = changes(model, run.data, candidates)
+    # changes the fitted observables cannot see (a DOP estimator's bias on Mueller data) are not screened
+    run.blind = blind_changes(all_candidates, run.base_post.likelihood.objects)
+    if base is None:
+        run.say(f"[base] fitting {model.name} ({len(run.data)} geometries) ...")
+        base = fit_for_elpd(run.base_post, _vector(run.base_optimum, run.base_post), run.seed, run.max_steps,
+                            run.posterior_method)
+    run.base = base
+    run.clock["base"] = time.perf_counter()
+    return [c for c in all_candidates if c not in run.blind]
+
+
+def _screen(run: _Run, all_candidates: list) -> list[CandidateFit]:
+    """Every change's maximum log posterior (searched near the base's optimum, or known from ``run.searched``) and
+    its gain over the base's, best first."""
+    run.say(f"[base] done; screening {len(all_candidates)} candidate effects")
+    if run.blind:
+        run.say(f"[screen] not screened: {', '.join(c.label for c in run.blind)} ({BLIND_REASON})")
+    posteriors = [run.fits.posterior(change.model) for change in all_candidates]
+    unsearched = [i for i, change in enumerate(all_candidates) if model_key(change.model) not in run.searched]
 
     def screened_line(i: int, done: int) -> None:
-        if progress:
-            gain = searched[model_key(all_candidates[i].model)][0] - base_best
-            _say(f"[screen {done}/{len(all_candidates)}] {all_candidates[i].label:<32s} max log posterior gain {gain:9.2f} "
-                 f"({time.perf_counter() - clock['start']:.0f} s)")
+        gain = run.searched[model_key(all_candidates[i].model)][0] - run.base_best
+        run.say(f"[screen {done}/{len(all_candidates)}] {all_candidates[i].label:<32s} max log posterior gain {gain:9.2f}")
 
     done = 0
     for i in [i for i in range(len(all_candidates)) if i not in unsearched]:
         done += 1
         screened_line(i, done)
-    jobs = [(all_candidates[i].model, posteriors[i], all_candidates[i], base_optimum, screening_evaluations)
+    jobs = [(all_candidates[i].model, posteriors[i], all_candidates[i], run.base_optimum, run.screening_evaluations)
             for i in unsearched]
-    for j, found in fits.run("screen", jobs, rng):
-        searched[model_key(all_candidates[unsearched[j]].model)] = found
+    for j, found in run.fits.run("screen", jobs, run.rng):
+        run.searched[model_key(all_candidates[unsearched[j]].model)] = found
         done += 1
         screened_line(unsearched[j], done)
     screened = []
     for change, post in zip(all_candidates, posteriors):
-        best, optimum = searched[model_key(change.model)]
-        screened.append(CandidateFit(change, post, float(best - base_best), _vector(optimum, post)))
+        best, optimum = run.searched[model_key(change.model)]
+        screened.append(CandidateFit(change, post, float(best - run.base_best), _vector(optimum, post)))
     screened.sort(key=lambda c: -c.screening_gain)
+    run.clock["screening"] = time.perf_counter()
+    return screened
 
-    clock["screening"] = time.perf_counter()
+
+def _select(run: _Run, screened: list, top: int, simplifications: int) -> list[CandidateFit]:
+    """The changes to refit: the ``top`` screened and their equals, the twins of an addition among them (where the
+    fitted observables do not separate the two), the changes asked for (``confirm``) and ``simplifications`` changes
+    with fewer free parameters; each starts from the best of its screening and a global multistart. A change asked
+    for whose optimum alone decides (``_plugin_decides``) is not refitted."""
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
     to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c.screening_gain, screened[0].screening_gain)]
     # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits; not
     # where the fitted observables separate the two (``Effect.separated_by``: the full Mueller matrix for an analyser
     # and depolarized light), where the twin is refitted only if its own screening earns it
-    fitted = set(base_post.likelihood.observable_names)
+    fitted = set(run.base_post.likelihood.observable_names)
     twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins
              if not fitted & set(separating_observables(c.effect, t))}
     to_confirm += [c for c in screened if c not in to_confirm and c.kind == "add" and c.effect in twins]
-    to_confirm += [c for c in screened if c not in to_confirm and c.label in confirm]
+    to_confirm += [c for c in screened if c not in to_confirm and c.label in run.confirm]
     # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
     # significant, diagnose --rounds takes one that predicts as well (Occam)
-    simpler = [c for c in screened if c not in to_confirm and c.posterior.ndim < base_post.ndim
+    simpler = [c for c in screened if c not in to_confirm and c.posterior.ndim < run.base_post.ndim
                and c.screening_gain > -2 * MIN_DELTA_ELPD]
     to_confirm += simpler[:simplifications]
     # screening searched near the base model; a refit starts from the best of that and a global multistart
-    leaders = dict(fits.run("leader", [(c.model, c.posterior) for c in to_confirm], rng))
+    leaders = dict(run.fits.run("leader", [(c.model, c.posterior) for c in to_confirm], run.rng))
     for i, c in enumerate(to_confirm):
         value, theta = leaders[i]
-        if value > c.screening_gain + base_best:
-            c.screening_gain, c.optimum = float(value - base_best), theta
-            searched[model_key(c.model)] = value, dict(zip(c.posterior.priors.names, theta))
-    # changes refitted only because the caller asked (``confirm``: the slot alternatives diagnose --rounds weighs
-    # at its end) and that their optima alone already show to differ significantly are not refitted
-    asked = [c for c in to_confirm if c.label in confirm]
+        if value > c.screening_gain + run.base_best:
+            c.screening_gain, c.optimum = float(value - run.base_best), theta
+            run.searched[model_key(c.model)] = value, dict(zip(c.posterior.priors.names, theta))
+    # changes refitted only because the caller asked (the slot alternatives diagnose --rounds weighs at its end)
+    # and that their optima alone already show to differ significantly are not refitted
+    asked = [c for c in to_confirm if c.label in run.confirm]
     if asked:
-        best = np.array([base.draws.best[n] for n in base_post.priors.names], float)
-        base_pointwise = base_post.log_prob_pointwise(best[None, :])[0]
-    decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(base.loo.get("p_loo", 0.0)))]
-    to_confirm = [c for c in to_confirm if c not in decided]
-    clock["leaders"] = time.perf_counter()
-    if progress and to_confirm:
-        _say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c.label for c in to_confirm)} "
-             f"({time.perf_counter() - clock['start']:.0f} s)")
+        best = np.array([run.base.draws.best[n] for n in run.base_post.priors.names], float)
+        base_pointwise = run.base_post.log_prob_pointwise(best[None, :])[0]
+    decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(run.base.loo.get("p_loo", 0.0)))]
+    run.clock["leaders"] = time.perf_counter()
+    return [c for c in to_confirm if c not in decided]
+
+
+def _refit(run: _Run, to_confirm: list) -> list[CandidateFit]:
+    """The selected changes refitted (their posteriors, pointwise ELPD-LOO and signatures), the best screened
+    first; one the best refit so far shows clearly worse (``_dominated``, where the criterion allows) is not refitted
+    but weighed again against the final front-runner. Returns the refitted ones."""
+    if to_confirm:
+        run.say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c.label for c in to_confirm)}")
     # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found; the
     # best screened first, so that candidates its refit shows to be clearly worse need no refit of their own
-    to_confirm.sort(key=lambda c: -c.screening_gain)
+    to_confirm = sorted(to_confirm, key=lambda c: -c.screening_gain)
+    base_fit = median_fit(run.base.posterior, run.base.draws.flat_samples())
     refitted, dominated = [], []
 
     def refit(batch: list) -> None:
-        jobs = [(c.model, c.posterior, c.optimum, seed, max_steps, posterior_method) for c in batch]
-        for i, inv in fits.run("refit", jobs, rng):
-            c = batch[i]
-            diff = inv.loo["pointwise"] - base_loo
-            c.inversion, c.pointwise = inv, inv.loo["pointwise"]
-            c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
-            c.rmse_dop_after, c.signatures = inv.summary.fit["rmse_dop"], signatures(base, inv, base_fit)
-            c.significant = significant(c.delta_elpd, c.delta_elpd_se)
-            refitted.append(c)
-            if progress:
-                q = posterior_quality(inv)
-                refused = f": {q['laplace_refused']}" if q.get("laplace_refused") else ""
-                how = ("Laplace-IS" if q["engine"] == "laplace-is"
-                       else f"emcee (the Laplace approximation was not trusted{refused})"
-                       + ("" if q["converged"] else f", which {_unconverged(q)}"))
-                _say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {c.label}: {how}, "
-                     f"{inv.summary.seconds:.0f} s ({time.perf_counter() - clock['start']:.0f} s)")
+        jobs = [(c.model, c.posterior, c.optimum, run.seed, run.max_steps, run.posterior_method) for c in batch]
+        for i, inv in run.fits.run("refit", jobs, run.rng):
+            _record_refit(batch[i], inv, run.base, base_fit, run.base_loo)
+            refitted.append(batch[i])
+            run.say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {batch[i].label}: "
+                    f"{posterior_words(inv)}, {inv.summary.seconds:.0f} s")
 
     def weigh(pending: list) -> list:
-        """``pending`` less those the best refit so far shows clearly worse (``_dominated``; not the changes asked for)."""
-        lead = _front_runner(refitted) if criterion == "loo" else None
-        skip = [c for c in pending if lead is not None and c.label not in confirm and _dominated(c, lead)]
-        if progress and skip:
-            _say(f"[confirm] not refitted, clearly worse than {lead.label}: {', '.join(c.label for c in skip)}")
+        """``pending`` less those the best refit so far shows clearly worse (not the changes asked for)."""
+        lead = _front_runner(refitted) if run.criterion.skips_dominated else None
+        skip = [c for c in pending if lead is not None and c.label not in run.confirm and _dominated(c, lead)]
+        if skip:
+            run.say(f"[confirm] not refitted, clearly worse than {lead.label}: {', '.join(c.label for c in skip)}")
         dominated.extend(skip)
         return [c for c in pending if c not in skip]
 
@@ -208,88 +251,69 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
         refit(again)
     for c in dominated:
         c.dominated_by = _front_runner(refitted).label
-    to_confirm = [c for c in to_confirm if c not in dominated]
-    confirmed = [c for c in to_confirm]
-    base_evidence = evidence_of(base, base_post, seed) if criterion == "evidence" else base.log_evidence
+    return [c for c in to_confirm if c not in dominated]
+
+
+def _record_refit(c: CandidateFit, inv, base, base_fit, base_loo) -> None:
+    """A refit's Result, pointwise ELPD-LOO, difference to the base with its SE, signatures and significance."""
+    diff = inv.loo["pointwise"] - base_loo
+    c.inversion, c.pointwise = inv, inv.loo["pointwise"]
+    c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
+    c.rmse_dop_after, c.signatures = inv.summary.fit["rmse_dop"], signatures(base, inv, base_fit)
+    c.significant = significant(c.delta_elpd, c.delta_elpd_se)
+
+
+def _rank(run: _Run, confirmed: list) -> list[CandidateFit]:
+    """The refitted changes by the criterion, best first, each with its ln Bayes factor where the evidence is known;
+    among the significant changes tied with the best, the one with the fewest free parameters leads."""
+    base_evidence = run.criterion.evidence(run.base, run.base_post, run.seed)
     for c in confirmed:
-        own = evidence_of(c.inversion, c.posterior, seed) if criterion == "evidence" else c.inversion.log_evidence
+        own = run.criterion.evidence(c.inversion, c.posterior, run.seed)
         if own is not None and base_evidence is not None:
             c.delta_log_evidence = own[0] - base_evidence[0]
             c.delta_log_evidence_error = float(np.hypot(own[1], base_evidence[1]))
-        if criterion == "evidence":
-            c.significant = significant_evidence(c.delta_log_evidence, c.delta_log_evidence_error)
-    if criterion == "evidence":
-        confirmed.sort(key=lambda c: -c.delta_log_evidence)
-    else:
-        confirmed.sort(key=lambda c: -c.delta_elpd)
+        run.criterion.judge(c)
+    confirmed = sorted(confirmed, key=run.criterion.order)
     if confirmed and confirmed[0].significant:
         # changes that fit equally well (tied with the best): the one with fewer free parameters leads
-        group = [c for c in confirmed if c.significant and (c is confirmed[0] or _tied(confirmed[0], c))]
+        group = [c for c in confirmed if c.significant and (c is confirmed[0] or tied(confirmed[0], c))]
         simplest = min(group, key=lambda c: (c.posterior.ndim, -c.delta_elpd))
         confirmed.remove(simplest)
         confirmed.insert(0, simplest)
-    clock["confirmation"] = time.perf_counter()
+    run.clock["confirmation"] = time.perf_counter()
+    return confirmed
 
-    ranking = []
-    for i, c in enumerate(confirmed):
-        entry = {"effect": c.effect, "change": c.label, "delta_elpd": c.delta_elpd, "delta_elpd_se": c.delta_elpd_se,
-                 "rmse_dop_after": c.rmse_dop_after, "significant": c.significant,
-                 "delta_log_evidence": c.delta_log_evidence, "delta_log_evidence_error": c.delta_log_evidence_error,
-                 "explains_misfit": not _structured(c.inversion.summary), "screening_gain": c.screening_gain,
-                 "explanation": _explain(c, base)}
-        if c.delta_log_evidence is not None:
-            entry["explanation"] += (f" ln Bayes factor over the model {c.delta_log_evidence:+.1f} +- "
-                                     f"{c.delta_log_evidence_error:.1f}"
-                                     + (" (the criterion here)." if criterion == "evidence" else "."))
-        entry["posterior"] = posterior_quality(c.inversion)
-        if not entry["posterior"]["converged"]:
-            entry["explanation"] += (f" Its posterior {_unconverged(entry['posterior'])}: its delta ELPD-LOO is less "
-                                     "certain than its SE says.")
-        ranking.append(entry)
-    for c in [c for c in screened if c not in to_confirm]:
-        entry = {"effect": c.effect, "change": c.label, "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-                 "significant": False, "screening_gain": c.screening_gain,
-                 "explanation": f"Screened out: its best fit gains only {c.screening_gain:.1f} in log posterior."}
-        if c.dominated_by is not None:
-            entry.update(dominated_by=c.dominated_by, delta_to_leader=-c.dominance_delta,
-                         delta_to_leader_se=c.dominance_se, explanation=(
-                f"Not refitted: its log likelihood at its best optimum (screening gain {c.screening_gain:.1f}) falls "
-                f"below the refitted ELPD-LOO of '{c.dominated_by}' by {c.dominance_delta:.1f} +- {c.dominance_se:.1f}, "
-                f"beyond 2 SE and any LOO correction ({c.dominance_margin:.0f}): it can neither lead nor tie."))
-        if c.plugin_delta is not None:
-            entry.update(plugin_delta=c.plugin_delta, plugin_se=c.plugin_se, explanation=(
-                f"Not refitted: at the two optima its log likelihood differs from the model's by {c.plugin_delta:+.1f} "
-                f"+- {c.plugin_se:.1f}, beyond 2 SE and any LOO correction ({c.plugin_margin:.0f}); significantly "
-                f"{'better' if c.plugin_delta > 0 else 'worse'}."))
-        ranking.append(entry)
+
+def _explain(run: _Run, model: Model, screened: list, confirmed: list) -> DiagnosisRecord:
+    """The diagnosis: a ranking entry per refitted change (``refitted_entry``) and per change screened out or not
+    refitted (``unrefitted_entry``), the verdict with its ties, the conclusion, and where the time went."""
+    ranking = [refitted_entry(c, run.base, run.criterion.note) for c in confirmed]
+    ranking += [unrefitted_entry(c) for c in screened if c not in confirmed]
     verdict = "none"
     if confirmed and confirmed[0].significant:
-        lead = confirmed[0]
-        verdict = lead.verdict
-        tied = [c for c in confirmed[1:] if c.significant and _tied(lead, c)]
-        if tied:
-            ranking[0]["tied_with"] = [c.verdict for c in tied]
-            for other in tied:
-                sep = None
-                if lead.kind == other.kind == "add":
-                    sep = separating_measurement(lead.effect, other.effect)
-                sep = sep or "a measurement in which they predict differently"
-                ranking[0]["explanation"] += (f" It fits these data as well as '{other.label}' (equal within noise): the "
-                                              f"two are twins here; {sep} would separate them.")
+        verdict = confirmed[0].verdict
+        tie_words(ranking[0], confirmed)
     for entry, c in zip(ranking, confirmed):
         entry["free_parameters"] = c.posterior.ndim
-    return DiagnosisRecord({"model": model.name, "criterion": criterion, "fit": base.summary.fit, "base_posterior": posterior_quality(base),
-            "ranking": ranking, "verdict": verdict,
-            "not_screened": [{"change": c.label, "reason": BLIND_REASON} for c in blind],
-            "free_parameters": base_post.ndim,
-            "residual_structure": base.summary.residual_structure["findings"],
-            "conclusion": _conclusion(base, confirmed, verdict),
-            "seconds": {"base_fit": clock["base"] - clock["start"], "screening": clock["screening"] - clock["base"],
-                        "confirmation": clock["confirmation"] - clock["screening"],
-                        "leader_search": clock["leaders"] - clock["screening"],
-                        "total": clock["confirmation"] - clock["start"], "candidates_screened": len(screened),
-                        "candidates_refitted": len(confirmed)}},
+    clock, base = run.clock, run.base
+    return DiagnosisRecord({"model": model.name, "criterion": run.criterion.name, "fit": base.summary.fit,
+                            "base_posterior": posterior_quality(base), "ranking": ranking, "verdict": verdict,
+                            "not_screened": [{"change": c.label, "reason": BLIND_REASON} for c in run.blind],
+                            "free_parameters": run.base_post.ndim,
+                            "residual_structure": base.summary.residual_findings,
+                            "conclusion": conclusion(base, confirmed, verdict),
+                            "seconds": {"base_fit": clock["base"] - clock["start"],
+                                        "screening": clock["screening"] - clock["base"],
+                                        "confirmation": clock["confirmation"] - clock["screening"],
+                                        "leader_search": clock["leaders"] - clock["screening"],
+                                        "total": clock["confirmation"] - clock["start"],
+                                        "candidates_screened": len(screened), "candidates_refitted": len(confirmed)}},
                            base, confirmed)
+
+
+def _close(a: float, b: float) -> bool:
+    """Screening gains equal within the optimiser's reach (1 unit of log posterior, or 1 %)."""
+    return abs(a - b) < 1.0 + 0.01 * max(abs(a), abs(b))
 
 
 def _same_posterior(result, posterior) -> bool:
@@ -301,29 +325,6 @@ def _same_posterior(result, posterior) -> bool:
     a, b = own.likelihood, posterior.likelihood
     return (a.data is b.data and model_key(a.model) == model_key(b.model) and a.observables == b.observables
             and own.priors.describe() == posterior.priors.describe())
-
-
-def posterior_quality(inv) -> dict:
-    """How a refit's posterior was obtained and whether it can be trusted (``Result.diagnostics``): the engine
-    (laplace-is: trusted weights by construction; emcee: R-hat <= 1.01 and ESS >= 400, the targets a run waits for,
-    else not converged within its cap, or ``stopped_early`` where its ELPD-LOO had settled: ``elpd_settled``; and
-    ``laplace_refused``: why the Laplace approximation was not used, where it was tried)."""
-    d = inv.diagnostics
-    if d.engine == "laplace-is":
-        return {"engine": d.engine, "converged": True, "pareto_k": d.pareto_k, "effective_draws": d.ess_min}
-    quality = {"engine": d.engine, "converged": d.converged, "rhat_max": d.rhat_max, "ess_min": d.ess_min, "steps": d.steps,
-               "stopped_early": bool(inv.summary.sampler.get("stopped_early", False))}
-    if inv.summary.laplace_refused:
-        quality["laplace_refused"] = inv.summary.laplace_refused
-    return quality
-
-
-def _unconverged(quality: dict) -> str:
-    """``posterior_quality``'s figures for a chain that stopped short of its targets, in words."""
-    text = f"did not converge ({quality['steps']} emcee steps, R-hat {quality['rhat_max']:.3f}, ESS {quality['ess_min']:.0f}"
-    if quality.get("stopped_early"):
-        text += f"; stopped where its two halves' ELPD-LOO agreed within {elpd_settled.TOLERANCE:g}"
-    return text + ")"
 
 
 # the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it
@@ -377,150 +378,3 @@ def _say(text: str) -> None:
     print(f"  {text}", file=sys.stderr, flush=True)
 
 
-def signatures(base, inv, base_fit=None) -> dict:
-    """Per observable: the base fit's standardised residuals, and what the candidate changes in the
-    prediction in the same noise units (its signature), their correlation and the share of the
-    base chi^2 the candidate removes. ``base_fit``: the base's ``median_fit``, if already computed."""
-    lik = base.posterior.likelihood
-    mu0, scale = base_fit or median_fit(base.posterior, base.draws.flat_samples())
-    mu1, _ = median_fit(inv.posterior, inv.draws.flat_samples())
-    out = {}
-    for o in base.posterior.likelihood.observables:
-        observed = lik.standardise(o, mu0[o], scale[o])
-        remaining = lik.standardise(o, mu1[o], scale[o])
-        signature = observed - remaining
-        corr = float(np.corrcoef(observed, signature)[0, 1]) if np.std(signature) > 0 and np.std(observed) > 0 else 0.0
-        out[o] = {"observed": observed, "signature": signature, "correlation": corr,
-                  "chi2_removed": float(1 - np.sum(remaining**2) / max(np.sum(observed**2), 1e-300))}
-    return out
-
-
-def _where(data, observed) -> str:
-    """Where the base misfit is largest, in words."""
-    worst = np.argsort(-np.abs(observed))[:max(3, len(observed) // 10)]
-    tr, ti = data.theta_r[worst], data.theta_i[worst]
-    return (f"theta_i {ti.min():.0f}-{ti.max():.0f} deg, theta_r {tr.min():.0f}-{tr.max():.0f} deg, "
-            f"residuals mostly {'positive' if np.mean(observed[worst]) > 0 else 'negative'}")
-
-
-MIN_DELTA_ELPD = 4.0
-
-
-# Bayes factors: ln B > 3 (B > 20) is "strong" evidence on Kass & Raftery's scale (JASA 90, 773 (1995))
-MIN_LOG_BAYES_FACTOR = 3.0
-CRITERIA = ("loo", "evidence")
-
-
-def significant_evidence(delta: float, error: float) -> bool:
-    """A change the evidence favours: ln Bayes factor > 3 (strong, Kass & Raftery 1995) and > 2 x its error."""
-    return bool(delta > MIN_LOG_BAYES_FACTOR and delta > 2 * error)
-
-
-def evidence_of(result, posterior, seed: int) -> tuple[float, float]:
-    """(ln Z, error) of a fit: its own where its engine gives one (Laplace-IS where its weights are trusted,
-    nested sampling), else from the ``nested`` engine on the same posterior."""
-    if result.log_evidence is not None:
-        return result.log_evidence
-    from ..infer.engine_registry import engines
-
-    nested = engines.get("nested").result(posterior, seed=seed)
-    result.summary.log_evidence = nested.summary.log_evidence
-    return nested.log_evidence
-
-
-def significant(delta: float, se: float) -> bool:
-    """delta ELPD-LOO > 2 SE and > 4: below 4 the SE of a difference is unreliable and the models
-    predict alike (Sivula, Magnusson & Vehtari 2020; Vehtari's cross-validation FAQ). Nested models
-    on pure noise otherwise give tiny deltas with tinier SEs."""
-    return bool(delta > 2 * se and delta > MIN_DELTA_ELPD)
-
-
-def _close(a: float, b: float) -> bool:
-    """Screening gains equal within the optimiser's reach (1 unit of log posterior, or 1 %)."""
-    return abs(a - b) < 1.0 + 0.01 * max(abs(a), abs(b))
-
-
-def _structured(summary: RunSummary) -> bool:
-    """Residuals still carry structure: runs/trends flagged, or a misfit above the noise floor: with known noise
-    chi^2 > 1.5; with inferred noise that the data also measure themselves, an inferred level above 1.5x the
-    measured one; with inferred noise alone chi^2 ~ 1 by construction and says nothing."""
-    if summary.noise:  # the data measure their noise: explained only within 1.5x of it
-        return not explains(summary.noise) or summary.residual_structure["structured"]
-    above_floor = not inferred_noise_levels(summary) and summary.fit["chi2_red"] > 1.5
-    return above_floor or summary.residual_structure["structured"]
-
-
-def _conclusion(base, confirmed, verdict) -> str:
-    """One paragraph: what to add, and whether the library can explain what remains."""
-    if verdict == "none":
-        if _structured(base.summary):
-            return ("No candidate in the library improves ELPD-LOO by more than 2 SE (and 4), yet the residuals of "
-                    f"{base.summary.model} are structured ({describe_fit(base.summary)}; "
-                    "see residual_structure): an effect outside the library is likely. Write it as a plug-in "
-                    "effect and rerun diagnose.")
-        return (f"No candidate improves ELPD-LOO by more than 2 SE (and 4), and the residuals of {base.summary.model} "
-                "look like noise: nothing is missing at this noise level.")
-    lead = next(c for c in confirmed if c.verdict == verdict)
-    after = lead.inversion.summary
-    text = f"{lead.label[0].upper()}{lead.label[1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
-    if _structured(after):
-        text += (f" It helps, but does not explain the misfit (partly explained): after it the residuals are still "
-                 f"structured ({describe_fit(after)}; " + " ".join(after.residual_structure["findings"])
-                 + "). Run diagnose again on the changed model (or use --rounds); if nothing else in the library helps, "
-                 "the rest comes from an effect outside it.")
-    else:
-        text += f" After it the residuals look like noise ({describe_fit(after)}): explained."
-    return text
-
-
-SAME_MISFIT = 0.8
-
-
-def _tied(a, b) -> bool:
-    """Two explanations of the same misfit that the data cannot tell apart: their signatures (what each
-    changes in the prediction, in noise units) correlate >= 0.8, and neither is significantly better by
-    the rule of ``significant`` (|delta ELPD| <= 2 SE of the difference, or <= 4; exact twins differ by
-    sampling noise only; Sivula, Magnusson & Vehtari 2020). Changes that fix different parts of the
-    misfit are not alternatives (the rounds take both), however close their ELPD.
-    (A 1-SE rule without the signature split near-equals: on a rough dielectric render 'remove shadowing'
-    +1202.5 and 'replace shadowing by smith' +1198.1 came out as a confident choice between them; a 2-SE
-    rule alone tied 'remove shadowing' with 'add depolarization', which mend different misfits.)"""
-    diff = a.pointwise - b.pointwise
-    return (_signature_correlation(a, b) >= SAME_MISFIT
-            and not significant(abs(float(diff.sum())), float(np.sqrt(len(diff) * np.var(diff)))))
-
-
-def _signature_correlation(a, b) -> float:
-    sa = np.concatenate([a.signatures[o]["signature"] for o in sorted(a.signatures)])
-    sb = np.concatenate([b.signatures[o]["signature"] for o in sorted(b.signatures)])
-    if np.std(sa) == 0 or np.std(sb) == 0:
-        return 1.0 if np.std(sa) == np.std(sb) else 0.0
-    return float(np.corrcoef(sa, sb)[0, 1])
-
-
-def _explain(c: CandidateFit, base) -> str:
-    cls = registry.get(c.effect)
-    physics = _first_sentence(cls.description)
-    if c.kind == "replace":
-        physics = f"Replace {c.change.replaced} by {c.effect}: {physics}"
-    elif c.kind == "remove":
-        physics = f"Remove {c.effect} ({physics[0].lower()}{physics[1:]})"
-    rmse0, rmse1 = base.summary.fit["rmse_dop"], c.rmse_dop_after
-    rmse = f"RMSE(DOP) {rmse0:.4f} -> {rmse1:.4f}; " if rmse0 is not None and rmse1 is not None else ""
-    noise0, noise1 = inferred_noise_levels(base.summary), inferred_noise_levels(c.inversion.summary)
-    if noise0:
-        rmse += "inferred noise " + ", ".join(f"{k} {noise0[k]:.3g} -> {noise1.get(k, float('nan')):.3g}" for k in noise0) + "; "
-    verdict = "significant" if c.significant else "not significant (gain within 2 SE or below 4)"
-    why = []
-    data = base.posterior.likelihood.data
-    for o, s in c.signatures.items():
-        change = (f"removes {100 * s['chi2_removed']:.0f} % of their chi^2" if s["chi2_removed"] >= 0
-                  else f"raises their chi^2 by {-100 * s['chi2_removed']:.0f} % (it trades this fit for another)")
-        why.append(f"{o}: the base model misses most at {_where(data, s['observed'])}; this effect's signature "
-                   f"correlates {s['correlation']:+.2f} with the residuals and {change}")
-    bounds = [bound_finding(f) for f in c.inversion.summary.at_bound]
-    if c.significant and _structured(c.inversion.summary):
-        bounds.insert(0, "it helps, but does not explain the misfit: after it the residuals are still structured ("
-                      + " ".join(c.inversion.summary.residual_structure["findings"]) + ").")
-    return (f"{physics} Adding it changes ELPD-LOO by {c.delta_elpd:+.1f} +- {c.delta_elpd_se:.1f} ({verdict}); "
-            f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))

@@ -13,7 +13,9 @@ from ..infer.diagnostics import describe_fit, fit_words, inferred_noise_levels, 
 from ..physics.model import Model
 from .changes import changes, slot_alternatives
 from .candidate_fits import CandidateFits
-from .diagnose import _structured, diagnose, significant
+from .criteria import significant
+from .diagnose import diagnose
+from .explain import structured
 from .records import CandidateFit, DiagnosisRecord, RoundsRecord, Rung
 from ..infer.run_summary import RunSummary
 
@@ -23,7 +25,7 @@ def _step(summary: RunSummary, change=None, delta=None, se=None, tied=(), altern
             "alternatives": list(alternatives),
             "fit": summary.fit, "inferred_noise": inferred_noise_levels(summary), "noise": summary.noise,
             "residual_structure": summary.residual_structure["findings"],
-            "structured": bool(_structured(summary)), "at_bound": summary.at_bound}
+            "structured": bool(structured(summary)), "at_bound": summary.at_bound}
 
 
 def as_rungs(result: RoundsRecord) -> list[Rung]:

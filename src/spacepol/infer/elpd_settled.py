@@ -14,7 +14,7 @@ from .diagnostics import PARETO_K_LIMIT, psis_loo, relative_efficiency
 from .inference_data import batched
 
 # the two halves' ELPD-LOO agree within this many log units: half of the smallest difference diagnose calls
-# significant (``diagnose.MIN_DELTA_ELPD``, 4)
+# significant (``criteria.MIN_DELTA_ELPD``, 4)
 TOLERANCE = 2.0
 FIRST_STEP = 2000  # no earlier (a chain's first thousand steps on a ridge are still its burn-in)
 EVERY = 1000  # steps between checks (each evaluates up to 2 x DRAWS_PER_HALF draws' pointwise log likelihood)

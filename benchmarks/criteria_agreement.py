@@ -2,7 +2,7 @@
 
     python benchmarks/criteria_agreement.py [--cases all | --cases N] [--out reports/criteria]
 
-On the hidden-effect validation suite (``spacepol.criticism.hidden_effects``: data from ``paper + E`` with known
+On the hidden-effect validation suite (``spacepol.validation.hidden_effects``: data from ``paper + E`` with known
 noise, and null sets), ``diagnose`` from ``paper`` with every registered candidate and ``criterion="evidence"``:
 each refitted change then holds both delta ELPD-LOO (+- SE) and the ln Bayes factor (+- error; Laplace-IS where its
 weights are trusted, else nested sampling). From the same refits, the LOO rule picks the best change with delta >
@@ -54,7 +54,7 @@ def main():
 
     from spacepol.criticism.criteria import significant, significant_evidence
     from spacepol.criticism.diagnose import diagnose
-    from spacepol.criticism.hidden_effects import BASE, measurement, suite
+    from spacepol.validation.hidden_effects import BASE, measurement, suite
     from spacepol.physics import Model
 
     cases = suite()

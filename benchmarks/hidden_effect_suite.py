@@ -9,7 +9,7 @@ two noise levels, two angle samplings and two materials alternating, plus 8 null
 Swap cases (issue 10): data from ``specular+smith+lambertian + E`` (physical shadowing and a reciprocal
 body term) for E in none, dop_bias, angle_offset, extinction, polarized_diffuse, ggx, two sets each;
 `diagnose --rounds 4` from ``paper``, whose shadowing and body are wrong for these data
-(``spacepol.criticism.swap_suite``). Right = the path holds the shadowing swap and E (or a tied
+(``spacepol.validation.swap_suite``). Right = the path holds the shadowing swap and E (or a tied
 twin), the nulls gain no addition, and the final reduced chi^2 < 1.5.
 
 Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts). A partial run
@@ -23,8 +23,8 @@ import time
 from pathlib import Path
 
 from spacepol._runtime import spawned_pool
-from spacepol.criticism.hidden_effects import run_suite, suite, summarise
-from spacepol.criticism.swap_suite import run_swap_case, summarise_swaps, swap_suite
+from spacepol.validation.hidden_effects import run_suite, suite, summarise
+from spacepol.validation.swap_suite import run_swap_case, summarise_swaps, swap_suite
 from spacepol.io.atomic import save_figure, write_json
 from spacepol.report.criticism_figures import validation_figure
 

@@ -54,7 +54,7 @@ def test_diagnose_rejects_unknown_candidates(tmp_path):
 
 def _case_report(case, candidates=None, top=3):
     from spacepol.criticism.diagnose import diagnose
-    from spacepol.criticism.hidden_effects import BASE, measurement
+    from spacepol.validation.hidden_effects import BASE, measurement
     from spacepol.physics import Model
 
     return diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(case.seed), seed=0,
@@ -62,7 +62,7 @@ def _case_report(case, candidates=None, top=3):
 
 
 def _null_case():
-    from spacepol.criticism.hidden_effects import suite
+    from spacepol.validation.hidden_effects import suite
 
     return [c for c in suite() if c.effect is None][0]
 
@@ -89,7 +89,7 @@ def test_null_set_gets_verdict_none_with_the_whole_library():
 @pytest.mark.slow  # 50 s; the same tie and its explanation: test_mueller_criticism's DOP+BRDF test, in the default run
 def test_twins_are_reported_with_the_measurement_that_separates_them():
     """Hidden extinction: depolarization predicts the same DOP and BRDF (the body lobe is depolarized)."""
-    from spacepol.criticism.hidden_effects import Case, score
+    from spacepol.validation.hidden_effects import Case, score
 
     case = Case("twin", "extinction", {"e": 0.7}, "paint", 0.002, 0.01, "in-plane-84", 6)
     report = _case_report(case, candidates=["extinction", "depolarization", "dop_bias"], top=2)
@@ -219,14 +219,14 @@ def test_the_ranking_does_not_depend_on_how_many_processes_fit_the_candidates():
     same seed gives in one process, number for number (each task's seed is its kind's and model's own); control:
     another seed does change the screening gains, so the comparison can see a difference. Nor does a candidate's fit
     depend on the other candidates: with dop_bias left out, polarized_diffuse's changes get the same numbers."""
-    from spacepol.criticism.hidden_effects import suite
+    from spacepol.validation.hidden_effects import suite
 
     case = next(c for c in suite() if c.effect == "polarized_diffuse")
     candidates = ["polarized_diffuse", "dop_bias"]
 
     def ranking(workers, seed=case.seed):
         from spacepol.criticism.diagnose import diagnose
-        from spacepol.criticism.hidden_effects import BASE, measurement
+        from spacepol.validation.hidden_effects import BASE, measurement
         from spacepol.physics import Model
 
         report = diagnose(measurement(case), Model.from_string(BASE), np.random.default_rng(seed), seed=0,
@@ -356,7 +356,7 @@ def test_a_candidate_clearly_worse_than_the_refitted_leader_is_not_refitted(monk
     and its refitted ELPD-LOO is indeed significantly below the leader's (the skip lost nothing), with the same
     verdict. (A candidate near the leader: ``test_dominance_needs_a_gap_beyond_its_standard_error_and_margin``.)"""
     from spacepol.criticism import diagnose as dg
-    from spacepol.criticism.hidden_effects import suite
+    from spacepol.validation.hidden_effects import suite
 
     case = next(c for c in suite() if c.effect == "polarized_diffuse")
     report = _case_report(case, candidates=["polarized_diffuse", "lambertian", "dop_bias"], top=3)

@@ -63,7 +63,7 @@ def test_diagnose_by_evidence_names_the_hidden_effect_and_reports_both_criteria(
     """A hidden polarized diffuse lobe: with ``criterion="evidence"`` the ln Bayes factor leads and is significant
     (> 3 and > 2 errors); every refitted entry holds both differences; an unknown criterion is one line."""
     from spacepol.criticism.diagnose import diagnose
-    from spacepol.criticism.hidden_effects import BASE, measurement, suite
+    from spacepol.validation.hidden_effects import BASE, measurement, suite
     from spacepol.errors import SpacepolError
     from spacepol.physics import Model
 

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from spacepol.criticism.hidden_effects import HIDDEN_VALUES, Case, effect_size, run_suite, suite, summarise
+from spacepol.validation.hidden_effects import HIDDEN_VALUES, Case, effect_size, run_suite, suite, summarise
 from spacepol.criticism.changes import changes
 from spacepol.physics import Model
 from spacepol.physics.registry import BUILTIN_EFFECTS
 
 
 def test_suite_covers_every_composable_builtin_effect_and_null_sets():
-    from spacepol.criticism.hidden_effects import measurement
+    from spacepol.validation.hidden_effects import measurement
 
     cases = suite()
     composable = {c.effect for c in changes(Model.from_string("paper"), measurement(cases[0])) if c.kind == "add"}
@@ -65,7 +65,7 @@ def test_swap_cases_reach_noise_through_the_right_changes():
     cases take the shadowing swap and E (or a tied twin) and end at reduced chi^2 < 1.5, and neither
     null set gains an addition. The target was set before the suite was run, as for the renders (6 of 7)."""
     from spacepol._runtime import spawned_pool
-    from spacepol.criticism.swap_suite import run_swap_case, summarise_swaps, swap_suite
+    from spacepol.validation.swap_suite import run_swap_case, summarise_swaps, swap_suite
 
     with spawned_pool(2) as pool:
         rows = list(pool.map(run_swap_case, swap_suite()))

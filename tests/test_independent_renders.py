@@ -20,7 +20,7 @@ import pytest
 
 from renders import EXPECTED, HIDDEN, rendered_set
 from spacepol._runtime import spawned_pool
-from spacepol.criticism.swap_suite import shadowing_swapped
+from spacepol.validation.swap_suite import shadowing_swapped
 from spacepol.io.measurements import write_table
 
 TRUE_MODELS = {"none": "specular+smith", "pplastic": "specular+smith+polarized_diffuse",

@@ -37,7 +37,7 @@ def test_laplace_is_agrees_with_emcee_where_the_posterior_is_near_gaussian(near_
 def at_bound():
     """The validation suite's null set (k = 0 at its bound) under paper + extinction: (posterior, optimum, the
     adapted declared-parameter approximation, emcee)."""
-    from spacepol.criticism.hidden_effects import measurement, suite
+    from spacepol.validation.hidden_effects import measurement, suite
 
     data = measurement([c for c in suite() if c.effect is None][0])
     post = Posterior.build(data, Model.from_string("paper+extinction"))

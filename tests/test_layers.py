@@ -119,3 +119,24 @@ def test_the_checks_see_a_cycle_and_an_upward_import(tmp_path):
     assert cycles(graph) == [["spacepol.physics.a", "spacepol.physics.b"]]
     assert "spacepol.api" in graph["spacepol.physics.b"]
     assert layer_of("spacepol.physics.b", layers()) < layer_of("spacepol.api", layers())
+
+
+def private_imports(package: Path = PACKAGE) -> list[str]:
+    """``from X import _name`` anywhere in the package: another module's private name."""
+    out = []
+    for path in package.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__":
+                out += [f"{module_name(path, package)}: {a.name}" for a in node.names
+                        if a.name.startswith("_") and not a.name.startswith("__")]
+    return out
+
+
+def test_no_module_imports_another_modules_private_name(tmp_path):
+    assert private_imports() == []
+    # negative control: the check finds one where it is
+    pkg = tmp_path / "spacepol"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from .b import _hidden\n")
+    assert private_imports(pkg) == ["spacepol.a: _hidden"]

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
 from .errors import ParameterError
 from .io import Dataset, read_measurements, write_table
 from .io.output import check_output_dir, check_output_file
 from .physics.geometry import Geometry
-from .api.inputs import parse_engine_options, parse_references, parse_settings
-from .physics.model import Model, build_model
+from .api.inputs import build_model, parse_engine_options, parse_references, parse_settings
+from .physics.model import Model
 
 
 def _prediction_columns(geometry: Geometry, prediction) -> dict:
@@ -142,43 +141,31 @@ def run(args) -> int:
 
 
 def optimize(args) -> int:
-    """``invert-mcmc optimize``: one optimizer (``ga``, ``de``, ``nlopt:ALGO``) on the paper's objective, or a sampler
-    (``emcee``, ...) on the posterior; prints its EngineResult as JSON."""
+    """``invert-mcmc optimize``: ``api.optimize``; prints its EngineResult as JSON."""
     import json
 
-    from .infer.engine_registry import SAMPLER, check_method, engines, optimize as run_optimizer
-    from .infer.objective import PaperObjective
-    from .infer.prior_set import PriorSet
+    from .api import optimize as run_optimize
+    from .infer.engine_registry import check_method
     from .io.atomic import jsonable
 
-    check_method(args.method)
-    data = load_dataset(args)
-    posterior = build_posterior(args, data)
-    engine = engines.get(args.method)
-    if engine.kind == SAMPLER:
-        result = engine.result(posterior, seed=args.seed).draws
-    else:
-        model = posterior.likelihood.model
-        model_priors = PriorSet(model.parameters, {n: posterior.priors.priors[n] for n in posterior.priors.priors
-                                                   if n in {p.name for p in model.parameters}})
-        result = run_optimizer(args.method, PaperObjective(data, model, model_priors),
-                               np.random.default_rng(args.seed), model.name, seed=args.seed)
+    check_method(args.method)  # before the data are read
+    result = run_optimize(load_dataset(args), args.model, args.method, args.prior, observables=args.observables,
+                          dispersion=getattr(args, "dispersion", None), seed=args.seed)
     print(json.dumps(jsonable(result.to_json()), indent=2))
     return 0
 
 
 def compare(args) -> int:
-    """``invert-mcmc compare``: several engines and seeds on the same posterior; figures and table in ``--out``."""
-    from .report.compare import run_comparison
-
+    """``invert-mcmc compare``: ``api.compare``, several engines and seeds on the same posterior; figures and table in
+    ``--out``."""
+    from .api import compare as run_compare
     from .infer.engine_registry import check_method
 
     check_output_dir(args.out)
     for method in args.methods or []:
         check_method(method)
-    data = load_dataset(args)
-    posterior = build_posterior(args, data)
-    run_comparison(posterior, data, Path(args.out), methods=args.methods, seeds=args.seeds, base_seed=args.seed)
+    run_compare(load_dataset(args), args.model, args.methods, args.seeds, args.out, args.prior,
+                observables=args.observables, dispersion=getattr(args, "dispersion", None), seed=args.seed)
     return 0
 
 

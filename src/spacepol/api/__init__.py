@@ -12,7 +12,7 @@ The reasoning behind it, and what was measured: the internals page of the docume
 from __future__ import annotations
 
 from .inputs import parse_wavelengths, load, build_model, parse_observables, build_posterior, parameter_values
-from .inversion import invert, calibrate
+from .inversion import invert, calibrate, optimize, compare
 from .forward import forward, synth
 from .observing import Contrast, contrast, observe, frame, Sky, sky
 from .criticism import Diagnosis, diagnose, Ladder, ladder, Design, design
@@ -26,6 +26,8 @@ __all__ = [
     "parameter_values",
     "invert",
     "calibrate",
+    "optimize",
+    "compare",
     "forward",
     "synth",
     "Contrast",

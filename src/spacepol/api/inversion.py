@@ -128,3 +128,43 @@ def calibrate(model, priors: dict, geometry, *, engine="emcee", replicates: int 
     return run_sbc(engine, build_model(model), priors, geometry, replicates, np.random.default_rng(seed),
                    engine_options=engine_options, noise_dop=noise_dop, noise_brdf=noise_brdf,
                    mueller_noise=mueller_noise, likelihood_noise_scale=likelihood_noise_scale, progress=progress)
+
+
+def optimize(data, model="paper", method: str = "ga", prior=None, *, observables=None, dispersion=None,
+             seed: int = 0):
+    """One engine's best fit on ``data`` (an EngineResult; ``to_json()`` is what ``invert-mcmc optimize`` prints):
+    an optimizer (``ga``, ``de``, ``nlopt:ALGO``) on the paper's objective over ``model``'s own parameters, or a
+    sampler (``emcee``, ...) on the posterior."""
+    from ..infer.engine_registry import SAMPLER, check_method, engines
+    from ..infer.engine_registry import optimize as run_optimizer
+    from ..infer.objective import PaperObjective
+    from ..infer.prior_set import PriorSet
+
+    check_method(method)
+    data = load(data) if isinstance(data, (str, Path)) else data
+    posterior = build_posterior(data, model, prior, observables, dispersion)
+    engine = engines.get(method)
+    if engine.kind == SAMPLER:
+        return engine.result(posterior, seed=seed).draws
+    fitted = posterior.likelihood.model
+    own = {p.name for p in fitted.parameters}
+    model_priors = PriorSet(fitted.parameters, {n: pr for n, pr in posterior.priors.priors.items() if n in own})
+    return run_optimizer(method, PaperObjective(data, fitted, model_priors), np.random.default_rng(seed), fitted.name,
+                         seed=seed)
+
+
+def compare(data, model="paper", methods=None, seeds: int = 3, out="reports/compare", prior=None, *,
+            observables=None, dispersion=None, seed: int = 0) -> Path:
+    """Several engines (``methods``; default every optimizer and the samplers), ``seeds`` seeds each, on the same
+    posterior against its reference; figures and table in ``out`` (returned)."""
+    from ..infer.engine_registry import check_method
+    from ..io.output import check_output_dir
+    from ..report.compare import run_comparison
+
+    out = check_output_dir(Path(out))
+    for method in methods or []:
+        check_method(method)
+    data = load(data) if isinstance(data, (str, Path)) else data
+    posterior = build_posterior(data, model, prior, observables, dispersion)
+    run_comparison(posterior, data, out, methods=methods, seeds=seeds, base_seed=seed)
+    return out

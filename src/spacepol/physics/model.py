@@ -259,8 +259,3 @@ class Model:
 
 
 Effect._model_type = Model  # effect + effect -> Model (physics.effect)
-
-
-def build_model(spec: str | Model) -> Model:
-    """``spec`` as a Model: a Model as is, a string through ``Model.from_string``."""
-    return spec if isinstance(spec, Model) else Model.from_string(spec)

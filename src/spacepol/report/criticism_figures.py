@@ -128,8 +128,8 @@ def residual_trends_figure(structure, fig=None) -> Figure:
 def validation_figure(rows: list[dict], swap_rows: list[dict]) -> Figure:
     """The validation suite in one picture: detection against effect size (additions to the right base
     model) and, where swap cases ran, reduced chi^2 along each diagnose --rounds path from paper."""
-    from ..criticism.hidden_effects import detection_figure
-    from ..criticism.swap_suite import swap_figure
+    from ..validation.hidden_effects import detection_figure
+    from ..validation.swap_suite import swap_figure
 
     panels = int(bool(rows)) + int(bool(swap_rows))
     fig = Figure(figsize=(7.0 * max(panels, 1), 4.2), layout="constrained")

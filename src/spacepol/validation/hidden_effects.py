@@ -23,7 +23,7 @@ from ..io.measurements import Dataset
 from ..physics.geometry import Geometry, default_grid
 from ..physics.model import Model
 from ..physics.registry import BUILTIN_EFFECTS, registry
-from .diagnose import diagnose
+from ..criticism.diagnose import diagnose
 
 BASE = "paper"
 MATERIALS = {  # two base materials the cases alternate between

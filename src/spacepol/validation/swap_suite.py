@@ -18,7 +18,7 @@ from ..io.measurements import Dataset
 from ..physics.model import Model
 from ..physics.registry import registry
 from .hidden_effects import HIDDEN_VALUES, NOISE, WAVELENGTH_UM, sampling
-from .rounds import diagnose_rounds
+from ..criticism.rounds import diagnose_rounds
 
 SWAP_BASE = "specular+smith+lambertian"
 START = "paper"

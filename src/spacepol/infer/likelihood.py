@@ -292,26 +292,12 @@ class Likelihood:
                 out.append(o.residual(ch, y[ch], predicted[ch], self.inferred(ch))[None])
             return out
 
-        def profile_levels(resids, n_sets):
-            """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
-            out = []
-            for name, lower, upper in levels:
-                squares, count = 0.0, 0
-                for (_, channels), resid in zip(groups, resids):
-                    for c, ch in enumerate(channels):
-                        if ch not in errors and self.noise_parameter(ch) == name:
-                            z = resid[c] / profiles.get(ch, 1.0)
-                            squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
-                            count += len(self.data)
-                out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
-            return out
-
         def channel_blocks(matrix):
             """(the log-likelihood of each channel group, (channels, P, N) each, in ``self.observables``' order;
             the profiled levels' values, (P,) each, in ``levels``' order)."""
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
             resids = residuals(values)
-            profiled = profile_levels(resids, matrix.shape[0]) if levels else []
+            profiled = self._profiled(levels, groups, resids, matrix.shape[0], errors, profiles) if levels else []
             values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
             blocks = []
             for (_, channels), resid in zip(groups, resids):
@@ -339,19 +325,21 @@ class Likelihood:
             value = value + sum(b.sum(axis=(0, 2)) for b in blocks if len(b) > 1)
             return jnp.stack([value, *profiled], axis=-1) if levels else value
 
-        def total(matrix):
-            # chunks of sets small enough that the sets x geometries intermediates stay in the CPU's cache:
-            # above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2 at 64)
-            n_sets = matrix.shape[0]
-            chunk = min(n_sets, max(1, _CACHE_NUMBERS // self.numbers_per_set))
-            chunk = next(c for c in range(chunk, 0, -1) if n_sets % c == 0)  # the largest that divides the batch
-            if chunk >= n_sets:
-                return summed(matrix)
-            blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
-            out = jax.lax.map(summed, blocks)
-            return out.reshape((n_sets,) + out.shape[2:])
+        return pointwise if which == 0 else _in_cache_sized_chunks(summed, self.numbers_per_set)
 
-        return pointwise if which == 0 else total
+    def _profiled(self, levels, groups, resids, n_sets, errors, profiles) -> list:
+        """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
+        out = []
+        for name, lower, upper in levels:
+            squares, count = 0.0, 0
+            for (_, channels), resid in zip(groups, resids):
+                for c, ch in enumerate(channels):
+                    if ch not in errors and self.noise_parameter(ch) == name:
+                        z = resid[c] / profiles.get(ch, 1.0)
+                        squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
+                        count += len(self.data)
+            out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
+        return out
 
     def _channel_groups(self) -> list[tuple]:
         """[(observable, its channels)]: an observable's channels as one group where it predicts them as one array
@@ -371,3 +359,21 @@ class Likelihood:
         nu = self.nu
         const = gammaln((nu + 1) / 2) - gammaln(nu / 2) - 0.5 * math.log(nu * math.pi)
         return const - xp.log(scale) - 0.5 * (nu + 1) * xp.log1p((resid / scale) ** 2 / nu)
+
+
+def _in_cache_sized_chunks(summed, numbers_per_set: int):
+    """``summed`` over a (P, D) matrix in chunks of sets small enough that the sets x geometries intermediates stay
+    in the CPU's cache: above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2
+    at 64)."""
+
+    def total(matrix):
+        n_sets = matrix.shape[0]
+        chunk = min(n_sets, max(1, _CACHE_NUMBERS // numbers_per_set))
+        chunk = next(c for c in range(chunk, 0, -1) if n_sets % c == 0)  # the largest that divides the batch
+        if chunk >= n_sets:
+            return summed(matrix)
+        blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
+        out = jax.lax.map(summed, blocks)
+        return out.reshape((n_sets,) + out.shape[2:])
+
+    return total

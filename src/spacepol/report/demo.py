@@ -173,6 +173,56 @@ def observe_demo_pass(run_dir: Path, out: Path, seed: int) -> tuple:
     return observation, lines
 
 
+def _demo_sections(out: Path, forward_lines, summary, hidden_path, hidden, truth, hidden_report, hidden_rungs, found,
+                   ptfe_report, ptfe_rungs, itself, scenario, contrast, limit_line, observed) -> list:
+    """The demo page's six sections, from what each step found."""
+    n, d = summary.parameters["n"], summary.diagnostics
+    sun = (contrast["sun"]["zenith_deg"], contrast["sun"]["azimuth_deg"])
+    return [
+        ("What this is", H.paragraph(
+            "spacepol's demo on NIST's measured Mueller-matrix BRDF of sintered PTFE (Germer, Appl. Opt. 56, 2017), "
+            "0.633 um, plane of incidence: the forward model, a Bayesian inversion of the measured Mueller matrix "
+            "(15 normalised elements) and BRDF, then model criticism "
+            "(what is missing from the paper's model, and the error falling as it is added), first on a synthetic set "
+            "with a known hidden effect, then on PTFE.")),
+        ("1. Forward model", H.bullets(forward_lines) + H.image(H.png_file_to_data_uri(out / "ptfe_dop.png"))),
+        ("2. Inversion with the paper's model", H.bullets(
+            [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
+             f"ESS min {d['ess_min']:.0f}; inferred noise: {_noise_words(summary)} (with inferred noise, reduced "
+             f"chi^2 is ~1 by construction)."]
+            + [summary.references["n"]["explanation"]] + summary.residual_structure["findings"]
+            + summary.identifiability["findings"])
+         + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'
+         + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),
+                   "Residuals: the BRDF's U shape is the paper's cos(theta_r) body term failing a nearly Lambertian "
+                   "material; DOP residuals lean positive where DOP is small (noise bias of a measured DOP).")),
+        ("3. A hidden effect, found and closed", H.paragraph(
+            f"{hidden_path.name}: {len(hidden)} synthetic geometries from the paper's model plus one hidden effect "
+            f"({truth['description']}). diagnose sees only the data.")
+         + _criticism_section(hidden_report, hidden_rungs, out / "hidden")
+         + H.paragraph(f"Revealed: the hidden effect was {truth['hidden_effect']} with {truth['hidden_parameters']} ({found}).")),
+        ("4. What the paper's model misses on PTFE", _criticism_section(ptfe_report, ptfe_rungs, out / "ptfe")
+         + H.paragraph("What the measurement says about itself, without a model (all 1,824 geometries at 0.633 um; "
+                       "the PTFE study, reports/ptfe_models/report.md, fits every one of them):") + H.bullets(itself)),
+        ("5. Against the daytime sky: Table 3 as distributions", H.paragraph(
+            f"The PTFE posterior (paper's model) at the paper's geometry (theta_i 30 deg, dphi 180 deg, theta_r 0-80 deg), "
+            f"the sky of the paper's site and time (sun from astropy: zenith {sun[0]:.2f} deg, azimuth {sun[1]:.2f} deg; "
+            f"the paper's 29 deg 30' / -4 deg 32' is wrong for that date), Rayleigh with P_max in "
+            f"[{scenario.sky['p_max_low']:g}, {scenario.sky['p_max_high']:g}], Table 2's instrument, micro-polarizer superpixels.")
+         + H.table(["case", "target DOP", "sky DOP", "limiting magnitude", "raw contrast", "polarization contrast"],
+                   [[r["case"]] + [f"{r[k]['median']:.4g} [{r[k]['q05']:.4g}, {r[k]['q95']:.4g}]" for k in
+                                   ("target_dop", "sky_dop", "limiting_magnitude", "intensity_contrast", "polarization_contrast")]
+                    for r in contrast["rows"]])
+         + H.paragraph(contrast["dominance"]) + H.paragraph(limit_line.capitalize() + ".")
+         + H.image(H.png_file_to_data_uri(out / "contrast" / "sky_maps.png"), "Sky DOP and AoP in the three projections, the two target directions in red.")
+         + H.image(H.png_file_to_data_uri(out / "contrast" / "projections.png"), "What each projection does to shapes and areas.")
+         + '<p><a href="contrast/report.html">Full contrast report (radiometry, the paper\'s Table 3 recomputed)</a></p>'),
+        ("6. A daytime pass", H.bullets(observed)
+         + H.image(H.png_file_to_data_uri(out / "observe" / "light_curves.png"), "Light curves and P_d(t) per detector.")
+         + '<p><a href="observe/report.html">Full pass report (assumptions, simulated exposures, every time step)</a></p>'),
+    ]
+
+
 def run_demo(out: Path, seed: int = 0) -> None:
     """The demo: forward model on PTFE, inversion, a hidden effect named on a synthetic set, diagnose and ladder on
     PTFE, Table 3 as distributions, the material on a daytime pass; report.html in ``out``."""
@@ -233,48 +283,7 @@ def run_demo(out: Path, seed: int = 0) -> None:
     for line in observed:
         print("   " + line)
 
-    sections = [
-        ("What this is", H.paragraph(
-            "spacepol's demo on NIST's measured Mueller-matrix BRDF of sintered PTFE (Germer, Appl. Opt. 56, 2017), "
-            "0.633 um, plane of incidence: the forward model, a Bayesian inversion of the measured Mueller matrix "
-            "(15 normalised elements) and BRDF, then model criticism "
-            "(what is missing from the paper's model, and the error falling as it is added), first on a synthetic set "
-            "with a known hidden effect, then on PTFE.")),
-        ("1. Forward model", H.bullets(forward_lines) + H.image(H.png_file_to_data_uri(out / "ptfe_dop.png"))),
-        ("2. Inversion with the paper's model", H.bullets(
-            [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
-             f"ESS min {d['ess_min']:.0f}; inferred noise: {_noise_words(summary)} (with inferred noise, reduced "
-             f"chi^2 is ~1 by construction)."]
-            + [summary.references["n"]["explanation"]] + summary.residual_structure["findings"]
-            + summary.identifiability["findings"])
-         + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'
-         + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),
-                   "Residuals: the BRDF's U shape is the paper's cos(theta_r) body term failing a nearly Lambertian "
-                   "material; DOP residuals lean positive where DOP is small (noise bias of a measured DOP).")),
-        ("3. A hidden effect, found and closed", H.paragraph(
-            f"{hidden_path.name}: {len(hidden)} synthetic geometries from the paper's model plus one hidden effect "
-            f"({truth['description']}). diagnose sees only the data.")
-         + _criticism_section(hidden_report, hidden_rungs, out / "hidden")
-         + H.paragraph(f"Revealed: the hidden effect was {truth['hidden_effect']} with {truth['hidden_parameters']} ({found}).")),
-        ("4. What the paper's model misses on PTFE", _criticism_section(ptfe_report, ptfe_rungs, out / "ptfe")
-         + H.paragraph("What the measurement says about itself, without a model (all 1,824 geometries at 0.633 um; "
-                       "the PTFE study, reports/ptfe_models/report.md, fits every one of them):") + H.bullets(itself)),
-        ("5. Against the daytime sky: Table 3 as distributions", H.paragraph(
-            f"The PTFE posterior (paper's model) at the paper's geometry (theta_i 30 deg, dphi 180 deg, theta_r 0-80 deg), "
-            f"the sky of the paper's site and time (sun from astropy: zenith {sun[0]:.2f} deg, azimuth {sun[1]:.2f} deg; "
-            f"the paper's 29 deg 30' / -4 deg 32' is wrong for that date), Rayleigh with P_max in "
-            f"[{scenario.sky['p_max_low']:g}, {scenario.sky['p_max_high']:g}], Table 2's instrument, micro-polarizer superpixels.")
-         + H.table(["case", "target DOP", "sky DOP", "limiting magnitude", "raw contrast", "polarization contrast"],
-                   [[r["case"]] + [f"{r[k]['median']:.4g} [{r[k]['q05']:.4g}, {r[k]['q95']:.4g}]" for k in
-                                   ("target_dop", "sky_dop", "limiting_magnitude", "intensity_contrast", "polarization_contrast")]
-                    for r in contrast["rows"]])
-         + H.paragraph(contrast["dominance"]) + H.paragraph(limit_line.capitalize() + ".")
-         + H.image(H.png_file_to_data_uri(out / "contrast" / "sky_maps.png"), "Sky DOP and AoP in the three projections, the two target directions in red.")
-         + H.image(H.png_file_to_data_uri(out / "contrast" / "projections.png"), "What each projection does to shapes and areas.")
-         + '<p><a href="contrast/report.html">Full contrast report (radiometry, the paper\'s Table 3 recomputed)</a></p>'),
-        ("6. A daytime pass", H.bullets(observed)
-         + H.image(H.png_file_to_data_uri(out / "observe" / "light_curves.png"), "Light curves and P_d(t) per detector.")
-         + '<p><a href="observe/report.html">Full pass report (assumptions, simulated exposures, every time step)</a></p>'),
-    ]
+    sections = _demo_sections(out, forward_lines, summary, hidden_path, hidden, truth, hidden_report, hidden_rungs,
+                              found, ptfe_report, ptfe_rungs, itself, scenario, contrast, limit_line, observed)
     write_text(out / "report.html", H.page("spacepol demo: PTFE", sections))
     print(f"wrote {out}/report.html (and ptfe_forward.csv, ptfe_dop.png, ptfe_paper/, hidden/, ptfe/, contrast/, observe/)")

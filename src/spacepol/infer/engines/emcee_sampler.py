@@ -131,59 +131,23 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     caller that needs one estimate rather than the whole posterior, ``enough(step, chain)`` at each check (the chain
     after burn-in, declared parameters, (steps, walkers, D)) may end the run before convergence (``elpd_settled``);
     ``info["stopped_early"]`` then says so, and R-hat and ESS are reported as they stand."""
-    from ..chain_file import chain_iterations, random_state_readable, replace_random_state
-
     start = time.perf_counter()
     ndim = posterior.ndim
     walkers = walkers or default_walkers(ndim)
-    backend = None
-    resumed = False
-    if backend_path is not None:
-        stored = chain_iterations(backend_path)  # ChainFileError (one line, the remedy) if damaged
-        if stored > 0 and not random_state_readable(backend_path):
-            # killed while emcee rewrote its random state: the steps are intact, so continue from them with a
-            # state drawn from this run's generator (reproducible from --seed and the step count)
-            replace_random_state(backend_path, np.random.RandomState(int(rng.integers(2**32)) ^ stored).get_state())
-        backend = BufferedHDFBackend(str(backend_path), name="mcmc")
-        if stored > 0:
-            if tuple(backend.shape) != (walkers, ndim):
-                from ...errors import SpacepolError
-
-                raise SpacepolError(f"{backend_path}: holds a chain of shape {tuple(map(int, backend.shape))}, this run "
-                                    f"needs {(walkers, ndim)}; use another --out or --restart")
-            resumed = True
-        else:
-            backend.reset(walkers, ndim)
+    backend, resumed = _open_chain(backend_path, rng, walkers, ndim)
 
     # every step evaluates half the ensemble: that size is compiled as it is (padding 18 walkers to the next
     # compiled size, 64, tripled the cost of a full-Mueller step); the whole ensemble (the start) goes in two halves
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.add(walkers // 2)
-    start_search = None
-    if resumed:
-        space = space or SamplingSpace.from_name(posterior.priors, str(_stored(backend_path, "spacepol_space",
-                                                                               SamplingSpace.family)))
-        stored_search = _stored(backend_path, "spacepol_start_search")
-        start_search = None if stored_search is None else json.loads(str(stored_search))
-    else:
-        random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-        initial, modes = starting_points(posterior, rng, walkers, initial)
-        if modes is not None:
-            start_search = modes.to_json() | {"findings": modes.findings()}
-            if progress:
-                for line in modes.findings():
-                    print(f"  {line}", file=sys.stderr)
-        if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
-            space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
-        if backend_path is not None:
-            extra = {} if start_search is None else {"spacepol_start_search": json.dumps(start_search)}
-            _store(backend_path, spacepol_space=space.name, **extra)
+    space, initial, start_search, random_state = _chain_start(posterior, rng, walkers, initial, space, backend_path,
+                                                              resumed, progress)
     log_prob = space.log_prob(posterior)
     sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=ridge_moves(), backend=backend)
     # called directly, not through emcee's wrapper, which prints every walker's position and a traceback before it
     # re-raises anything the function raises (Ctrl-C included), under the command line's one line
     sampler.log_prob_fn = log_prob
-    tau, previous_tau, capped = np.full(ndim, np.inf), None, True
+    tau, previous_tau, capped, stopped_early = np.full(ndim, np.inf), None, True, False
 
     def converged(tau, previous_tau):
         settled = (previous_tau is not None and np.all(np.isfinite(tau)) and np.all(np.isfinite(previous_tau))
@@ -198,29 +162,10 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         burn, _ = _kept(sampler, tau)
         return bool(enough(sampler.iteration, space.to_theta(sampler.get_chain(discard=burn))))
 
-    stopped_early = False
-
     if resumed:
         state = None
-        done = sampler.iteration
-        at_check = done % check_every == 0 or done >= max_steps
-        before = (done - check_every if done % check_every == 0 else done // check_every * check_every) if at_check \
-            else done // check_every * check_every  # the check whose tau an uninterrupted run holds next
-        previous_tau = _tau_at(sampler, before, space) if before >= check_every else None
-        if at_check:  # stopped right at a check: take that check's decision again
-            tau = _tau_at(sampler, done, space)
-            ok, *_ = converged(tau, previous_tau)
-            stopped_early = bool(not ok and done < max_steps and caller_has_enough(tau))
-            if ok or stopped_early or done >= max_steps:
-                capped = not ok and not stopped_early
-                if progress:
-                    how = "converged" if ok else "its caller's estimate settled" if stopped_early else "at the step cap"
-                    print(f"  the chain in {backend_path} is complete ({done} steps, {how}); writing the report",
-                          file=sys.stderr)
-                max_steps = done  # no further steps
-            previous_tau = tau
-        if progress and done < max_steps:
-            print(f"  resuming the chain in {backend_path} at step {done}", file=sys.stderr)
+        tau, previous_tau, capped, stopped_early, max_steps = _resume(sampler, space, check_every, max_steps, converged,
+                                                                      caller_has_enough, progress, backend_path)
     else:
         sampler.random_state = random_state
         state = space.to_z(initial)
@@ -236,10 +181,7 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         ok, long_enough, rhat, ess = converged(tau, previous_tau)
         previous_tau = tau
         if progress:
-            extra = f", R-hat {rhat:.3f}, ESS {ess:.0f}" if long_enough else ""
-            print(f"  step {sampler.iteration:6d}/{max_steps}: tau_max {np.max(tau):7.1f} "
-                  f"(need {tau_multiple:.0f} tau = {tau_multiple * np.max(tau):7.0f} steps), "
-                  f"acceptance {np.mean(sampler.acceptance_fraction):.2f}{extra}", file=sys.stderr)
+            _say_step(sampler, max_steps, tau, tau_multiple, f", R-hat {rhat:.3f}, ESS {ess:.0f}" if long_enough else "")
         if ok:
             capped = False
             break
@@ -251,6 +193,60 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
     if not np.all(np.isfinite(tau)):  # no block was run here (a finished chain): measure what is stored
         tau = _tau_at(sampler, sampler.iteration, space)
 
+    return _emcee_result(posterior, sampler, space, tau, walkers, capped, resumed, tau_multiple, stopped_early,
+                         start_search, model_name, seed, start)
+
+
+def _open_chain(backend_path, rng: np.random.Generator, walkers: int, ndim: int):
+    """(the chain file's backend or None, whether it holds steps to continue); a chain of another shape is one line."""
+    from ..chain_file import chain_iterations, random_state_readable, replace_random_state
+
+    if backend_path is None:
+        return None, False
+    stored = chain_iterations(backend_path)  # ChainFileError (one line, the remedy) if damaged
+    if stored > 0 and not random_state_readable(backend_path):
+        # killed while emcee rewrote its random state: the steps are intact, so continue from them with a
+        # state drawn from this run's generator (reproducible from --seed and the step count)
+        replace_random_state(backend_path, np.random.RandomState(int(rng.integers(2**32)) ^ stored).get_state())
+    backend = BufferedHDFBackend(str(backend_path), name="mcmc")
+    if stored == 0:
+        backend.reset(walkers, ndim)
+        return backend, False
+    if tuple(backend.shape) != (walkers, ndim):
+        from ...errors import SpacepolError
+
+        raise SpacepolError(f"{backend_path}: holds a chain of shape {tuple(map(int, backend.shape))}, this run "
+                            f"needs {(walkers, ndim)}; use another --out or --restart")
+    return backend, True
+
+
+def _chain_start(posterior, rng, walkers, initial, space, backend_path, resumed, progress):
+    """(the sampling space, the walkers' start in theta, the start-point search's record, emcee's random state): from
+    the chain file where the chain resumes, else from a start-point search (its modes recorded in the file)."""
+    if resumed:
+        space = space or SamplingSpace.from_name(posterior.priors, str(_stored(backend_path, "spacepol_space",
+                                                                               SamplingSpace.family)))
+        stored_search = _stored(backend_path, "spacepol_start_search")
+        return space, initial, None if stored_search is None else json.loads(str(stored_search)), None
+    start_search = None
+    random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
+    initial, modes = starting_points(posterior, rng, walkers, initial)
+    if modes is not None:
+        start_search = modes.to_json() | {"findings": modes.findings()}
+        if progress:
+            for line in modes.findings():
+                print(f"  {line}", file=sys.stderr)
+    if space is None:  # parameters whose bound the posterior reaches (from the walkers' median) keep their own
+        space = SamplingSpace(posterior.priors, declared=reaching_a_bound(posterior, np.median(initial, axis=0)))
+    if backend_path is not None:
+        extra = {} if start_search is None else {"spacepol_start_search": json.dumps(start_search)}
+        _store(backend_path, spacepol_space=space.name, **extra)
+    return space, initial, start_search, random_state
+
+
+def _emcee_result(posterior, sampler, space, tau, walkers, capped, resumed, tau_multiple, stopped_early, start_search,
+                  model_name, seed, start) -> EngineResult:
+    """The chain after burn-in, thinned by tau (every draw where the caller's check stopped it), as an EngineResult."""
     tau_max = float(np.max(tau))
     burn, thin = _kept(sampler, tau)
     if stopped_early:
@@ -278,3 +274,37 @@ def sample_emcee(posterior, rng: np.random.Generator, walkers: int | None = None
         seconds=time.perf_counter() - start, seed=-1 if seed is None else seed,
         samples=chain, log_prob=log_prob, info=info,
     )
+
+
+def _say_step(sampler, max_steps, tau, tau_multiple, extra: str) -> None:
+    """One progress line of the chain at a check."""
+    print(f"  step {sampler.iteration:6d}/{max_steps}: tau_max {np.max(tau):7.1f} "
+          f"(need {tau_multiple:.0f} tau = {tau_multiple * np.max(tau):7.0f} steps), "
+          f"acceptance {np.mean(sampler.acceptance_fraction):.2f}{extra}", file=sys.stderr)
+
+
+def _resume(sampler, space, check_every, max_steps, converged, caller_has_enough, progress, backend_path):
+    """Where a stored chain continues: (tau, previous tau, capped, stopped early, the step cap). A chain stopped right
+    at a check takes that check's decision again (converged, its caller's estimate settled, or at the cap: no further
+    steps); else it runs on with the tau an uninterrupted run would hold at its next check."""
+    tau, capped, stopped_early = np.full(sampler.ndim, np.inf), True, False
+    done = sampler.iteration
+    at_check = done % check_every == 0 or done >= max_steps
+    before = (done - check_every if done % check_every == 0 else done // check_every * check_every) if at_check \
+        else done // check_every * check_every  # the check whose tau an uninterrupted run holds next
+    previous_tau = _tau_at(sampler, before, space) if before >= check_every else None
+    if at_check:
+        tau = _tau_at(sampler, done, space)
+        ok, *_ = converged(tau, previous_tau)
+        stopped_early = bool(not ok and done < max_steps and caller_has_enough(tau))
+        if ok or stopped_early or done >= max_steps:
+            capped = not ok and not stopped_early
+            if progress:
+                how = "converged" if ok else "its caller's estimate settled" if stopped_early else "at the step cap"
+                print(f"  the chain in {backend_path} is complete ({done} steps, {how}); writing the report",
+                      file=sys.stderr)
+            max_steps = done  # no further steps
+        previous_tau = tau
+    if progress and done < max_steps:
+        print(f"  resuming the chain in {backend_path} at step {done}", file=sys.stderr)
+    return tau, previous_tau, capped, stopped_early, max_steps

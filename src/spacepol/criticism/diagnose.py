@@ -292,9 +292,7 @@ def _explain(run: _Run, model: Model, screened: list, confirmed: list) -> Diagno
     verdict = "none"
     if confirmed and confirmed[0].significant:
         verdict = confirmed[0].verdict
-        tie_words(ranking[0], confirmed)
-    for entry, c in zip(ranking, confirmed):
-        entry["free_parameters"] = c.posterior.ndim
+        ranking[0] = tie_words(ranking[0], confirmed)
     clock, base = run.clock, run.base
     return DiagnosisRecord({"model": model.name, "criterion": run.criterion.name, "fit": base.summary.fit,
                             "base_posterior": posterior_quality(base), "ranking": ranking, "verdict": verdict,

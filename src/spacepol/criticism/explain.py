@@ -5,6 +5,7 @@ refit's posterior can be trusted, and the explanation and conclusion a diagnosis
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from ..infer.run_summary import RunSummary
 from ..physics.registry import registry
 from .changes import separating_measurement
 from .criteria import significant
+from .records import RankingEntry
 
 
 def _first_sentence(text: str) -> str:
@@ -166,51 +168,56 @@ def posterior_words(inv) -> str:
             + ("" if q["converged"] else f", which {unconverged_words(q)}"))
 
 
-def refitted_entry(c, base, note: str) -> dict:
+def refitted_entry(c, base, note: str) -> RankingEntry:
     """A refitted change's ranking entry: both differences where known, its explanation and posterior quality."""
-    entry = {"effect": c.effect, "change": c.label, "delta_elpd": c.delta_elpd, "delta_elpd_se": c.delta_elpd_se,
-             "rmse_dop_after": c.rmse_dop_after, "significant": c.significant,
-             "delta_log_evidence": c.delta_log_evidence, "delta_log_evidence_error": c.delta_log_evidence_error,
-             "explains_misfit": not structured(c.inversion.summary), "screening_gain": c.screening_gain,
-             "explanation": explain_change(c, base)}
+    explanation = explain_change(c, base)
     if c.delta_log_evidence is not None:
-        entry["explanation"] += (f" ln Bayes factor over the model {c.delta_log_evidence:+.1f} +- "
-                                 f"{c.delta_log_evidence_error:.1f}" + note)
-    entry["posterior"] = posterior_quality(c.inversion)
-    if not entry["posterior"]["converged"]:
-        entry["explanation"] += (f" Its posterior {unconverged_words(entry['posterior'])}: its delta ELPD-LOO is less "
-                                 "certain than its SE says.")
-    return entry
+        explanation += (f" ln Bayes factor over the model {c.delta_log_evidence:+.1f} +- "
+                        f"{c.delta_log_evidence_error:.1f}" + note)
+    quality = posterior_quality(c.inversion)
+    if not quality["converged"]:
+        explanation += (f" Its posterior {unconverged_words(quality)}: its delta ELPD-LOO is less certain than its SE "
+                        "says.")
+    return RankingEntry(c.effect, c.label, c.screening_gain, explanation, refitted=True, delta_elpd=c.delta_elpd,
+                        delta_elpd_se=c.delta_elpd_se, rmse_dop_after=c.rmse_dop_after, significant=c.significant,
+                        delta_log_evidence=c.delta_log_evidence, delta_log_evidence_error=c.delta_log_evidence_error,
+                        explains_misfit=not structured(c.inversion.summary), posterior=quality,
+                        free_parameters=c.posterior.ndim)
 
 
-def unrefitted_entry(c) -> dict:
+def unrefitted_entry(c) -> RankingEntry:
     """A change screened out, dominated by the refitted leader, or decided by its optimum alone."""
-    entry = {"effect": c.effect, "change": c.label, "delta_elpd": None, "delta_elpd_se": None, "rmse_dop_after": None,
-             "significant": False, "screening_gain": c.screening_gain,
-             "explanation": f"Screened out: its best fit gains only {c.screening_gain:.1f} in log posterior."}
-    if c.dominated_by is not None:
-        entry.update(dominated_by=c.dominated_by, delta_to_leader=-c.dominance_delta,
-                     delta_to_leader_se=c.dominance_se, explanation=(
-            f"Not refitted: its log likelihood at its best optimum (screening gain {c.screening_gain:.1f}) falls "
-            f"below the refitted ELPD-LOO of '{c.dominated_by}' by {c.dominance_delta:.1f} +- {c.dominance_se:.1f}, "
-            f"beyond 2 SE and any LOO correction ({c.dominance_margin:.0f}): it can neither lead nor tie."))
     if c.plugin_delta is not None:
-        entry.update(plugin_delta=c.plugin_delta, plugin_se=c.plugin_se, explanation=(
+        return RankingEntry(c.effect, c.label, c.screening_gain, (
             f"Not refitted: at the two optima its log likelihood differs from the model's by {c.plugin_delta:+.1f} "
             f"+- {c.plugin_se:.1f}, beyond 2 SE and any LOO correction ({c.plugin_margin:.0f}); significantly "
-            f"{'better' if c.plugin_delta > 0 else 'worse'}."))
-    return entry
+            f"{'better' if c.plugin_delta > 0 else 'worse'}."), plugin_delta=c.plugin_delta, plugin_se=c.plugin_se,
+            **_dominance(c))
+    if c.dominated_by is not None:
+        return RankingEntry(c.effect, c.label, c.screening_gain, (
+            f"Not refitted: its log likelihood at its best optimum (screening gain {c.screening_gain:.1f}) falls "
+            f"below the refitted ELPD-LOO of '{c.dominated_by}' by {c.dominance_delta:.1f} +- {c.dominance_se:.1f}, "
+            f"beyond 2 SE and any LOO correction ({c.dominance_margin:.0f}): it can neither lead nor tie."),
+            **_dominance(c))
+    return RankingEntry(c.effect, c.label, c.screening_gain,
+                        f"Screened out: its best fit gains only {c.screening_gain:.1f} in log posterior.")
 
 
-def tie_words(entry: dict, confirmed: list) -> None:
-    """The leader's entry names the significant changes tied with it, and the measurement that would separate them."""
+def _dominance(c) -> dict:
+    """The fields of a change the refitted leader dominates (none where it is not dominated)."""
+    if c.dominated_by is None:
+        return {}
+    return {"dominated_by": c.dominated_by, "delta_to_leader": -c.dominance_delta, "delta_to_leader_se": c.dominance_se}
+
+
+def tie_words(entry: RankingEntry, confirmed: list) -> RankingEntry:
+    """The leader's entry, naming the significant changes tied with it and the measurement that would separate them."""
     lead = confirmed[0]
     ties = [c for c in confirmed[1:] if c.significant and tied(lead, c)]
-    if not ties:
-        return
-    entry["tied_with"] = [c.verdict for c in ties]
+    explanation = entry.explanation
     for other in ties:
         sep = separating_measurement(lead.effect, other.effect) if lead.kind == other.kind == "add" else None
         sep = sep or "a measurement in which they predict differently"
-        entry["explanation"] += (f" It fits these data as well as '{other.label}' (equal within noise): the two are "
-                                 f"twins here; {sep} would separate them.")
+        explanation += (f" It fits these data as well as '{other.label}' (equal within noise): the two are twins "
+                        f"here; {sep} would separate them.")
+    return replace(entry, tied_with=tuple(c.verdict for c in ties), explanation=explanation)

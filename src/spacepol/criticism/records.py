@@ -90,14 +90,75 @@ class CandidateFit:
         return self.inversion is not None
 
 
+_REFITTED_ONLY = ("delta_log_evidence", "delta_log_evidence_error", "explains_misfit", "posterior", "free_parameters")
+_WHERE_SET = ("tied_with", "dominated_by", "delta_to_leader", "delta_to_leader_se", "plugin_delta", "plugin_se")
+
+
+@dataclass(frozen=True, eq=False)
+class RankingEntry(Mapping):
+    """One change in a diagnosis's ranking, immutable: what it is (``effect``, ``change``), its differences to the
+    model where refitted (ELPD-LOO with SE, ln Bayes factor with error), its screening gain, the explanation in
+    words and its posterior's quality; for a change not refitted, why (``dominated_by`` the leader and the gap to
+    it, or ``plugin_delta``: its optimum alone decides); for the leader, the changes ``tied_with`` it. Reads like its
+    JSON entry (``entry["change"]``, ``entry.get("tied_with", [])``)."""
+
+    effect: str
+    change: str
+    screening_gain: float
+    explanation: str
+    refitted: bool = False
+    delta_elpd: float | None = None
+    delta_elpd_se: float | None = None
+    rmse_dop_after: float | None = None
+    significant: bool = False
+    delta_log_evidence: float | None = None
+    delta_log_evidence_error: float | None = None
+    explains_misfit: bool | None = None
+    posterior: dict | None = None
+    free_parameters: int | None = None
+    tied_with: tuple = ()
+    dominated_by: str | None = None
+    delta_to_leader: float | None = None
+    delta_to_leader_se: float | None = None
+    plugin_delta: float | None = None
+    plugin_se: float | None = None
+
+    def to_json(self) -> dict:
+        """The entry as diagnose.json holds it: the refit's fields on a refitted change, the reason on another."""
+        out = {"effect": self.effect, "change": self.change, "delta_elpd": self.delta_elpd,
+               "delta_elpd_se": self.delta_elpd_se, "rmse_dop_after": self.rmse_dop_after,
+               "significant": self.significant}
+        if self.refitted:
+            out |= {k: getattr(self, k) for k in _REFITTED_ONLY[:3]}
+        out |= {"screening_gain": self.screening_gain, "explanation": self.explanation}
+        if self.refitted:
+            out |= {k: getattr(self, k) for k in _REFITTED_ONLY[3:]}
+        out |= {k: (list(v) if isinstance(v, tuple) else v) for k in _WHERE_SET if (v := getattr(self, k))
+                not in (None, ())}
+        return out
+
+    def __getitem__(self, key):
+        return self.to_json()[key]
+
+    def __iter__(self):
+        return iter(self.to_json())
+
+    def __len__(self):
+        return len(self.to_json())
+
+
 @dataclass(eq=False)
 class DiagnosisRecord(_JSONView):
-    """One diagnosis: ``content`` (the JSON record: verdict, conclusion, ranking, timings), the base model's Result
-    (``base``) and the refitted candidates (``confirmed``, best first)."""
+    """One diagnosis: ``content`` (the record: verdict, conclusion, ranking of ``RankingEntry``, timings), the base
+    model's Result (``base``) and the refitted candidates (``confirmed``, best first)."""
 
     content: dict
     base: object
     confirmed: list[CandidateFit]
+
+    def to_json(self) -> dict:
+        """The record as JSON (what ``--json`` and the report files hold)."""
+        return {**self.content, "ranking": [e.to_json() for e in self.content["ranking"]]}
 
 
 @dataclass(eq=False)

@@ -283,17 +283,13 @@ def sky(args) -> int:
 
 
 def contrast(args) -> int:
-    """``invert-mcmc contrast``: a run folder's Result through a scenario (``api.contrast``); prints Table 3 as
-    distributions."""
-    from .detect.scenario import default_scenario, read_scenario
-    from .report.contrast_report import make_contrast_report, table3_lines
+    """``invert-mcmc contrast``: ``api.contrast`` on a run folder; prints Table 3 as distributions."""
+    from .api import contrast as contrast_of_run
+    from .report.contrast_report import table3_lines
 
-    scenario = read_scenario(args.scenario) if args.scenario else default_scenario()
     out = check_output_dir(Path(args.out) if args.out else Path(args.run_dir) / "contrast")
-    from .infer.result import Result
-
-    report = make_contrast_report(Result.load(args.run_dir), scenario, out, args.reading, args.draws, args.seed,
-                                  args.extrapolate, label=str(args.run_dir))
+    report = contrast_of_run(args.run_dir, args.scenario, out, reading=args.reading, draws=args.draws, seed=args.seed,
+                             extrapolate=args.extrapolate).content
     print("\n".join(table3_lines(report)))
     print(report["dominance"])
     print(f"wrote {out}/contrast.json, table3.md, contrast_histograms.png, report.html")

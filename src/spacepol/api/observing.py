@@ -38,12 +38,13 @@ class Contrast:
         return self.content
 
 
-def contrast(result: Result, scenario=None, out=None, *, reading: str = "corrected", draws: int = 20000, seed: int = 0,
-             extrapolate: bool = False) -> Contrast:
-    """Propagate a Result's posterior into target DOP, sky DOP, limiting magnitude and contrasts in ``scenario``
-    (a TOML path, a dict laid out as that file, or a Scenario; default the paper's Table 3). Over several wavelengths n and k at the scenario's
-    wavelength come from the Result's own model (dispersion law or interpolation; beyond the measured range only
-    with ``extrapolate``). With ``out`` the files of ``invert-mcmc contrast`` are written there."""
+def contrast(result: Result | str | Path, scenario=None, out=None, *, reading: str = "corrected", draws: int = 20000,
+             seed: int = 0, extrapolate: bool = False) -> Contrast:
+    """Propagate a Result's posterior (or that of a run folder, ``Result.load``) into target DOP, sky DOP, limiting
+    magnitude and contrasts in ``scenario`` (a TOML path, a dict laid out as that file, or a Scenario; default the
+    paper's Table 3). Over several wavelengths n and k at the scenario's wavelength come from the Result's own model
+    (dispersion law or interpolation; beyond the measured range only with ``extrapolate``). With ``out`` the files of
+    ``invert-mcmc contrast`` are written there; the report names the run by its folder where one was given."""
     from ..detect.contrast import contrast_of
     from ..detect.scenario import default_scenario, read_scenario, scenario_from_dict
 
@@ -57,11 +58,14 @@ def contrast(result: Result, scenario=None, out=None, *, reading: str = "correct
         from ..io.output import check_output_dir
 
         out = check_output_dir(Path(out))  # before the work
+    label = None
+    if isinstance(result, (str, Path)):
+        label, result = str(result), Result.load(result)
     content, per_case = contrast_of(result, scenario, seed, draws, reading, extrapolate)
     if out is not None:
         from ..report.contrast_report import assumptions, write_contrast_report
 
-        write_contrast_report(content, dict(per_case), out, result.summary.model,
+        write_contrast_report(content, dict(per_case), out, label or result.summary.model,
                               assumptions(result.summary, scenario, content["material"]))
     return Contrast(content, per_case)
 

@@ -1,5 +1,5 @@
 """The command line run in the test's own process: ``cli.main``, which the ``invert-mcmc`` entry point calls, with
-its exit status and output captured as ``subprocess.run`` would give them. A subprocess pays 4-7 s of imports per
+its exit status and output captured as ``subprocess.run`` would give them. A subprocess pays the imports again for every
 command; the tests that need a real process (signals, locks, a fresh interpreter) keep one."""
 
 import contextlib

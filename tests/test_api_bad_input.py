@@ -1,4 +1,4 @@
-"""Issue 25's item 8 through the Python API: the five inputs once accepted silently are refused with one line
+"""Bad input through the Python API: five inputs that could pass silently are refused with one line
 naming what is wrong (a SpacepolError, the same message the command line prints with exit status 2), and their
 controls are accepted."""
 

@@ -78,7 +78,7 @@ SLOW_OPTIONS = {
 @pytest.mark.slow
 @pytest.mark.parametrize("engine", sorted(SLOW_OPTIONS))
 def test_every_sampling_engine_is_calibrated_over_100_replicates_and_its_negative_control_fails(engine):
-    """Acceptance (issue 25, item 5): 100 replicates per engine; 30 with the wrong noise must fail."""
+    """Acceptance: 100 replicates per engine; 30 with the wrong noise must fail."""
     c = _calibrate(engine, 100, seed=2026, **SLOW_OPTIONS[engine])
     print(engine, c.to_json()["parameters"])
     assert c.replicates >= 95 and c.calibrated, c.failures()
@@ -107,7 +107,7 @@ def test_diagnoses_posterior_is_calibrated_on_a_curved_band():
 
 @pytest.mark.slow
 def test_diagnoses_posterior_is_calibrated_on_a_curved_band_over_100_replicates_and_its_control_fails():
-    """Acceptance (issue 47, item 6): 100 replicates; 30 with the likelihood told the noise is 3x smaller must fail."""
+    """Acceptance: 100 replicates; 30 with the likelihood told the noise is 3x smaller must fail."""
     c, ran = _ridge_calibration(100, seed=2027)
     print(ran, c.to_json()["parameters"])
     assert c.replicates == 100 and c.calibrated, c.failures()

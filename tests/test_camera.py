@@ -1,4 +1,4 @@
-"""Real micro-polarizer frames (issue 26, item 7): the project's demosaicking and Stokes maps against polanalyser's
+"""Real micro-polarizer frames: the project's demosaicking and Stokes maps against polanalyser's
 on the raw IMX250MZR mosaics in data/dofp/, and the four labelled filters' angles of polarization about 45 deg apart
 in their order, one sense of rotation."""
 

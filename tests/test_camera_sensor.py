@@ -1,4 +1,4 @@
-"""The simulated micro-polarizer camera (issue 26, item 4): a uniform field of known Stokes vector comes back within
+"""The simulated micro-polarizer camera: a uniform field of known Stokes vector comes back within
 its photon-noise expectation, the analysers' extinction ratio leaks polarization as computed analytically, and the
 DoLP estimator is biased and spread as the Rician distribution says."""
 

@@ -1,4 +1,4 @@
-"""`invert-mcmc contrast` (issue 5): posterior -> Table 3 distributions; scenario files; bad input."""
+"""`invert-mcmc contrast`: posterior -> Table 3 distributions; scenario files; bad input."""
 
 import json
 

@@ -1,4 +1,4 @@
-"""Detection at a fixed false-alarm rate (issue 26, item 5): thresholds set from sky-only frames, P_d of a point
+"""Detection at a fixed false-alarm rate: thresholds set from sky-only frames, P_d of a point
 source of known deflection against the Neyman-Pearson curve of each matched filter, a wrong threshold caught, and
 the DoLP detector's false-alarm rate held on independent sky frames."""
 

@@ -1,4 +1,4 @@
-"""`diagnose` (issue 4): a hidden effect is named; DESIGN's JSON fields; nulls, twins, priors, PTFE."""
+"""`diagnose`: a hidden effect is named; DESIGN's JSON fields; nulls, twins, priors, PTFE."""
 
 import json
 import sys
@@ -86,7 +86,7 @@ def test_null_set_gets_verdict_none_with_the_whole_library():
     assert "nothing is missing" in report["conclusion"]
 
 
-@pytest.mark.slow  # 50 s; the same tie and its explanation: test_mueller_criticism's DOP+BRDF test, in the default run
+@pytest.mark.slow  # the same tie and its explanation: test_mueller_criticism's DOP+BRDF test, in the default run
 def test_twins_are_reported_with_the_measurement_that_separates_them():
     """Hidden extinction: depolarization predicts the same DOP and BRDF (the body lobe is depolarized)."""
     from spacepol.validation.hidden_effects import Case, score

@@ -145,7 +145,7 @@ def _check_nested(data, prior, wider, reference, options):
 
 
 def test_nested_sampling_gives_the_evidence_and_the_posterior_fast(data, reference):
-    """Two free parameters with narrow priors (few shells: about 17 s)."""
+    """Two free parameters with narrow priors (few shells: fast)."""
     _check_nested(data, NARROW, Uniform(0.235, 0.275), reference, {"live": 200, "replicates": 3, "effective_draws": 800})
 
 
@@ -175,6 +175,6 @@ def test_nested_sampling_that_missed_the_best_mode_says_so(data, monkeypatch):
 
 @pytest.mark.slow
 def test_nested_sampling_gives_the_evidence_and_the_posterior(data):
-    """Three free parameters with their default priors (about 50 s)."""
+    """Three free parameters with their default priors."""
     reference = spacepol.invert(data, "paper", prior=PRIOR, seed=1)
     _check_nested(data, PRIOR, Uniform(0.02, 1.58), reference, {"live": 200, "replicates": 3, "effective_draws": 800})

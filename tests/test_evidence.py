@@ -1,4 +1,4 @@
-"""The evidence beside PSIS-LOO (issue 25, item 4): Laplace-IS's ln Z against nested sampling's on the same
+"""The evidence beside PSIS-LOO: Laplace-IS's ln Z against nested sampling's on the same
 posterior, the Occam factor of a wider prior seen by both, and ``diagnose --criterion evidence`` naming a hidden
 effect as the LOO criterion does."""
 

@@ -122,7 +122,7 @@ def test_a_parameter_whose_posterior_reaches_its_bound_keeps_its_own_coordinates
     assert not {"n", "k", "sigma", "rho_d"} & set(reaching_a_bound(ridge, find_optimum(ridge, np.random.default_rng(0))[1]))
 
 
-@pytest.mark.slow  # ~60 s; the fast NUTS check is the prior-only run above
+@pytest.mark.slow  # the fast NUTS check is the prior-only run above
 def test_nuts_and_emcee_reach_the_same_posterior_on_the_ridge():
     """On DOP alone (the k_s/rho_d ridge) both engines' 5/50/95 % quantiles agree within 4 combined Monte-Carlo
     standard errors (from each run's ESS); NUTS takes ~10 leapfrog steps a draw in the logit space.

@@ -1,6 +1,6 @@
-"""The validation suite of `diagnose` on data with hidden effects (issue 4's acceptance).
+"""The validation suite of `diagnose` on data with hidden effects.
 
-The full suite (40 cases, ~40 min) is `slow`; `benchmarks/hidden_effect_suite.py` runs the same
+The full suite (40 cases) is `slow`; `benchmarks/hidden_effect_suite.py` runs the same
 cases and prints the rates. The default run checks the pieces: the size measure and the suite's
 composition. (`tests/test_diagnose.py` runs a null case and a twin case with the whole library.)
 """
@@ -61,7 +61,7 @@ def test_hidden_effect_suite_meets_the_acceptance_rates():
 
 @pytest.mark.slow
 def test_swap_cases_reach_noise_through_the_right_changes():
-    """Data from specular+smith+lambertian+E, diagnose --rounds 4 from paper (issue 10): >= 10 of the 12
+    """Data from specular+smith+lambertian+E, diagnose --rounds 4 from paper: >= 10 of the 12
     cases take the shadowing swap and E (or a tied twin) and end at reduced chi^2 < 1.5, and neither
     null set gains an addition. The target was set before the suite was run, as for the renders (6 of 7)."""
     from spacepol._runtime import spawned_pool

@@ -1,4 +1,4 @@
-"""Model criticism on measurement sets rendered by an independent polarized renderer (issue 10).
+"""Model criticism on measurement sets rendered by an independent polarized renderer.
 
 Mitsuba 3 renders Beckmann facets with Smith shadowing plus one further effect (polarized diffuse from
 `pplastic`, an angle offset, a DOP bias, an analyser extinction, anisotropic roughness) or none
@@ -8,7 +8,7 @@ noise (reduced chi^2 < 1.5 with the known noise) in >= 6 of 7 sets, the path mus
 swap (the final model has smith in place of shadowing) and the hidden effect (or its twin), and the null sets must get no spurious addition.
 
 The default suite checks the renders themselves (the right model fits them at the noise level, so the
-conventions agree); the rounds over the whole library are slow (about 5 min for the 7 sets on 2 cores).
+conventions agree); the rounds over the whole library are slow.
 """
 
 import json

@@ -1,5 +1,5 @@
 """polarized_diffuse and the specular lobe against Mitsuba 3's `pplastic` (scalar_spectral_polarized) at the
-Mueller level (issue 11, item 4).
+Mueller level.
 
 Mitsuba expresses Mueller matrices in its own Stokes frames; the comparison uses quantities no rotation of
 the reference frames changes (rotations mix only S1 and S2): M11, the linear diattenuation sqrt(m12^2 + m13^2)

@@ -1,4 +1,4 @@
-"""Criticism on full-Mueller data (issue 11): sets rendered with NIST SCATMECH (tests/scatmech_sets.py),
+"""Criticism on full-Mueller data: sets rendered with NIST SCATMECH (tests/scatmech_sets.py),
 base `specular`, hidden none / depolarization / extinction / subsurface. With the full matrix diagnose
 names each, the twins depolarization and extinction without a tie; the same data reduced to DOP and
 BRDF leave those two tied (no measurement in them separates an analyser from depolarized light)."""
@@ -49,7 +49,7 @@ def test_dop_and_brdf_of_the_same_data_leave_them_tied(kind):
     assert "full Mueller matrix" in report["ranking"][0]["explanation"]
 
 
-@pytest.mark.slow  # 100 s; test_the_whole_library_on_full_mueller_sets covers subsurface and none too
+@pytest.mark.slow  # test_the_whole_library_on_full_mueller_sets covers subsurface and none too
 def test_a_hidden_subsurface_term_is_named_and_the_null_set_gets_none():
     report = _diagnose("subsurface", ["mueller", "brdf"], CANDIDATES)
     assert report["verdict"] in ("subsurface", "polarized_diffuse"), report["verdict"]

@@ -49,3 +49,46 @@ def test_the_check_finds_a_session_number(tmp_path):
     bad.write_text("fixed in Sess" + "ion 12\n", encoding="utf-8")
     good.write_text("one session of sampling, 12 chains\n", encoding="utf-8")
     assert len(history_lines([bad])) == 1 and not history_lines([good])
+
+
+ISSUE = re.compile(r"\bissue\s+#?\d+", re.IGNORECASE)
+# a run's time quoted in a comment or docstring: "took 12 s", "1.5-4 s", "2 ms per step", "10 M/s"
+TIMING = re.compile(r"(?<![\w.^-])\d+(?:\.\d+)?(?:-\d+(?:\.\d+)?)? ?(?:ms|s|min)\b(?![\^\-]1)|\bM/s\b")
+# physical quantities, not run times: an exposure, a unit example, a standard error s, a fit parameter, UT1-UTC
+PHYSICAL = ("1 s exposure", '"25 ms"', "2 s x PLUGIN", "3.13 s exp", "0.9 s by", "running 5 s after")
+
+
+def _comments_and_docstrings(path: Path) -> list[tuple[int, str]]:
+    import io
+    import tokenize
+
+    out = []
+    for tok in tokenize.generate_tokens(io.StringIO(path.read_text(encoding="utf-8")).readline):
+        if tok.type == tokenize.COMMENT or (tok.type == tokenize.STRING
+                                            and tok.string.lstrip("rbuRBU")[:3] in ('"""', "'''")):
+            out.append((tok.start[0], tok.string))
+    return out
+
+
+def quoted_times(text: str) -> list[str]:
+    """The run times and issue numbers quoted in ``text`` (a comment or docstring), physical quantities aside."""
+    found = []
+    for m in list(ISSUE.finditer(text)) + list(TIMING.finditer(text)):
+        context = text[max(0, m.start() - 30):m.end() + 15]
+        if not any(p in context for p in PHYSICAL):
+            found.append(m.group(0))
+    return found
+
+
+def test_no_run_times_or_issue_numbers_in_the_code_or_the_tests():
+    paths = sorted((ROOT / "src").rglob("*.py")) + sorted((ROOT / "tests").rglob("*.py"))
+    found = [f"{path.relative_to(ROOT)}:{line}: {hit}" for path in paths if path.name != "test_no_history.py"
+             for line, text in _comments_and_docstrings(path) for hit in quoted_times(text)]
+    assert found == []
+
+
+def test_the_timing_check_sees_a_quoted_run_time():
+    """Negative control: a comment quoting a run's time and a docstring naming an issue are found; a unit is not."""
+    assert quoted_times("Fast (issue 12).") == ["issue 12"]
+    assert quoted_times("# the fit took 12.5 s on PTFE, 2 ms per step") == ["12.5 s", "2 ms"]
+    assert quoted_times("# photons m^-2 s^-1 at 30 deg") == []

@@ -1,4 +1,4 @@
-"""Observables as objects (issue 11): each one's log density against a direct computation from the
+"""Observables as objects: each one's log density against a direct computation from the
 model's output, written here without the observable's code."""
 
 import math

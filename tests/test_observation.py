@@ -1,4 +1,4 @@
-"""A pass observed with a micro-polarizer camera (issue 26, items 3 and 5): the CIE sky's normalisation, observe.json's
+"""A pass observed with a micro-polarizer camera: the CIE sky's normalisation, observe.json's
 fields, P_d at the false-alarm rate where the target sends no light, and the Stokes detector never below intensity."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""A satellite's pass (issue 26, item 1): the project's geometry (skyfield's SGP4 and frames) against an independent
+"""A satellite's pass: the project's geometry (skyfield's SGP4 and frames) against an independent
 computation (the sgp4 package's TEME vectors taken to the site by astropy), the phase angle against the topocentric
 directions, each face's angles, and a TLE file's errors."""
 

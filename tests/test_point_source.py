@@ -1,4 +1,4 @@
-"""The pass's detection figures against simulated raw frames (issue 26): the pixel-level linear model of a point
+"""The pass's detection figures against simulated raw frames: the pixel-level linear model of a point
 source on the micro-polarizer mosaic (``detect.point_source``) predicts the P_d that frames simulated by the camera
 (Poisson electrons, read noise, the ADC) show, for a target at a random place within a superpixel, for the intensity
 and Stokes matched filters and the DoLP image. The control: the figure for a target always centred on a superpixel,

@@ -1,8 +1,7 @@
 """Every process pool in the repository is spawned, not forked.
 
 A forked child of a process that has started JAX's thread pool can inherit a lock held by a thread that does not
-exist in the child, and wait on it forever: the swap suite's two forked workers sat at 0 % CPU for 17 min.
-So each ``ProcessPoolExecutor`` names its ``mp_context`` (``spacepol._runtime.spawned_pool`` is the one to call) and
+exist in the child, and wait on it forever. So each ``ProcessPoolExecutor`` names its ``mp_context`` (``spacepol._runtime.spawned_pool`` is the one to call) and
 no code asks for the fork context or a bare ``multiprocessing.Pool`` (which forks on Linux)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Projections of the hemisphere (issue 5): Tissot distortion from complex-step Jacobians of the
+"""Projections of the hemisphere: Tissot distortion from complex-step Jacobians of the
 forward maps (independent of the module's own h, k formulas), inverses, the zenith cap's share."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Radiometry and detectability (issue 5): eqs 34-39 with Table 2, units, the micro-polarizer,
+"""Radiometry and detectability: eqs 34-39 with Table 2, units, the micro-polarizer,
 the paper's Table 3 recomputed."""
 
 import numpy as np

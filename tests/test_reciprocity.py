@@ -1,4 +1,4 @@
-"""Reciprocity (issue 11, item 4): the relation M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q, Q = diag(1, 1, -1, 1),
+"""Reciprocity: the relation M(r -> i, -dphi) = Q M(i -> r, dphi)^T Q, Q = diag(1, 1, -1, 1),
 in spacepol's frames is checked on NIST SCATMECH's reciprocal facet model (an independent implementation),
 then used to measure models and measured pairs."""
 

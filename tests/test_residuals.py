@@ -1,4 +1,4 @@
-"""Residual structure (issue 4, part 1): runs, autocorrelation and trends of standardised residuals."""
+"""Residual structure: runs, autocorrelation and trends of standardised residuals."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Model criticism, next rung (issue 10): replacements and removals besides additions, rounds until the
+"""Model criticism, next rung: replacements and removals besides additions, rounds until the
 residuals are noise, and effects that carry their own knowledge so a plug-in takes part on equal terms."""
 
 import json
@@ -141,7 +141,7 @@ def swap_path(tmp_path_factory):
     return tmp, json.loads((tmp / "d.json").read_text()), run
 
 
-@pytest.mark.slow  # the --rounds 3 path costs 50 s; test_tutorial climbs a path of rounds in the default suite
+@pytest.mark.slow  # test_tutorial climbs a path of rounds in the default suite
 def test_rounds_replace_the_wrong_parts_until_the_residuals_are_noise(swap_path):
     tmp, report, run = swap_path
     rounds = report["rounds"]

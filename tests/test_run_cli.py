@@ -102,7 +102,7 @@ def test_ptfe_run_converges_and_explains_the_index(tmp_path):
     assert s["residual_structure"]["runs"]["brdf"]["p"] < 0.01
     assert "model that is wrong" in (out / "report.html").read_text()
     # the diffuse weight piles against its bound 1, a reflectance's limit (a Lambertian-like PTFE asks for more than the
-    # paper's cos(theta_r) body term gives): flagged, and never called well constrained (issue 9)
+    # paper's cos(theta_r) body term gives): flagged, and never called well constrained
     flags = s["identifiability"]["at_bound"]
     assert any(f["parameter"] == "rho_d" and f["side"] == "upper" for f in flags), flags
     assert "rho_d reaches its physical limit 1" in (out / "report.html").read_text()  # a reflectance of 1

@@ -99,7 +99,7 @@ def _binomial_upper(trials, p=0.1, tail=0.002):
     return int(stats.binom.ppf(1 - tail, trials, p))
 
 
-@pytest.mark.slow  # 65 s; calibration in the default run: tests/test_calibration.py (SBC) and its negative control
+@pytest.mark.slow  # calibration in the default run: tests/test_calibration.py (SBC) and its negative control
 def test_recovery_90_percent_intervals_cover_the_truth():
     """DOP + BRDF data (which separate k_s from rho_d): every parameter is identifiable.
 

@@ -1,4 +1,4 @@
-"""Sky (issue 5): the sun from astropy, Rayleigh and Berry-Dennis-Lee skies, checked by vectors."""
+"""Sky: the sun from astropy, Rayleigh and Berry-Dennis-Lee skies, checked by vectors."""
 
 import numpy as np
 import pytest

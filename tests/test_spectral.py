@@ -1,4 +1,4 @@
-"""Several wavelengths inverted jointly (issue 11): shared geometry, n per wavelength or a Cauchy law."""
+"""Several wavelengths inverted jointly: shared geometry, n per wavelength or a Cauchy law."""
 
 import numpy as np
 import pytest
@@ -114,7 +114,7 @@ def test_diagnose_over_several_wavelengths_names_the_hidden_term_and_keeps_n_per
     assert "n@1.064" in hidden.base.summary.parameters
 
 
-@pytest.mark.slow  # 15 s; the null half of diagnose is in the default suite on one wavelength (test_diagnose)
+@pytest.mark.slow  # the null half of diagnose is in the default suite on one wavelength (test_diagnose)
 def test_diagnose_over_several_wavelengths_names_nothing_on_a_null_set():
     """Negative control of the test above: the same two-wavelength set without the Lambertian term."""
     from spacepol.criticism.changes import parse

@@ -1,4 +1,4 @@
-"""The paper's Table 3 limit through the pass chain (issue 26): Table 2's instrument as a camera of the chain gives
+"""The paper's Table 3 limit through the pass chain: Table 2's instrument as a camera of the chain gives
 eq 36's sky electrons and eq 35's target electrons exactly, and the chain's intensity detector reaches the required
 SNR where a matched filter over the k spot pixels must (closed form); the control, the spot placed across four
 superpixels instead of on one, needs about twice the flux."""

@@ -1,4 +1,4 @@
-"""The target's light over a pass (issue 26, item 2): a faceted Lambertian sphere against Lambert's analytic sphere,
+"""The target's light over a pass: a faceted Lambertian sphere against Lambert's analytic sphere,
 the polarization of specular reflection perpendicular to the sun - target - observer plane on the sky, and the
 sun's band irradiance against the solar constant."""
 

@@ -1,4 +1,4 @@
-"""Criticism with `volume` on full-Mueller data at PTFE-like geometries (issue 24).
+"""Criticism with `volume` on full-Mueller data at PTFE-like geometries.
 
 * sets rendered by NIST SCATMECH (tests/scatmech_sets.py ``ptfe_like_set``): facets + multiple scattering under
   the surface (Diffuse_Subsurface_BRDF_Model) + first-order volume scattering (First_Diffuse_BRDF_Model,

@@ -148,8 +148,8 @@ def configure_jax() -> None:
 
 def spawned_pool(workers: int, **options):
     """A ``ProcessPoolExecutor`` of ``workers`` processes started by spawn, never fork: a forked child of a process
-    that has started JAX's thread pool can inherit a lock held by a thread it does not have and wait on it forever
-    (the swap suite's two forked workers sat at 0 % CPU for 17 min). ``options``: the executor's other arguments."""
+    that has started JAX's thread pool can inherit a lock held by a thread it does not have and wait on it forever.
+    ``options``: the executor's other arguments."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 

@@ -27,8 +27,8 @@ from .changes import start_points
 # <= 1.01, both still required), not the 50 tau a run's reported posterior waits for (emcee's advice for a stable
 # tau itself); how far its delta ELPD lies from a 50-tau chain's is not yet measured
 ELPD_TAU_MULTIPLE = 20.0
-# PSIS-LOO of a candidate from at most this many draws (Vehtari et al. recommend >= 2,000 for a stable k-hat); a
-# 278-geometry full-Mueller fit kept ~9,000, and its log-likelihood, replicates and LOO took 22 s of each refit
+# PSIS-LOO of a candidate from at most this many draws (Vehtari et al. recommend >= 2,000 for a stable k-hat): a
+# converged chain keeps several times more, whose pointwise log-likelihood and LOO would dominate each refit
 ELPD_DRAWS = 2000
 
 POSTERIOR_METHODS = ("laplace", "emcee")
@@ -61,9 +61,8 @@ def fit_for_elpd(posterior: Posterior, centre, seed: int, max_steps: int, poster
     """The Result whose pointwise PSIS-LOO diagnose compares, started at ``centre`` (an optimum). "laplace": the
     Laplace approximation corrected by importance sampling (the registry's ``laplace`` engine), where its checks trust
     it, else emcee (why not: ``summary.laplace_refused``; stopped before convergence where the ELPD-LOO of its
-    two halves agree, ``elpd_settled``); "emcee": emcee always. On PTFE at 0.633 um (278 geometries; ``paper``,
-    ``paper+lambertian``) the two agree (SDs within 4 %, means within 0.09 SD, ELPD-LOO within -2.5 +- 1.9) in 7-12 s
-    instead of 39-48 s (``benchmarks/laplace_vs_emcee.py``)."""
+    two halves agree, ``elpd_settled``); "emcee": emcee always. Where the approximation is trusted the two agree
+    at a fraction of emcee's cost (``benchmarks/laplace_vs_emcee.py``)."""
     if posterior_method not in POSTERIOR_METHODS:
         raise ValueError(f"posterior_method {posterior_method!r}: one of {', '.join(POSTERIOR_METHODS)}")
     refusal = None
@@ -172,7 +171,7 @@ class CandidateFits:
 
     def posterior(self, model) -> Posterior:
         """The candidate's posterior in this process, not checked (``Posterior.ensure_checked``) until a task runs
-        here: the check compiles its likelihood (1.2-4 s for a full-Mueller model on PTFE), which a worker process
+        here: the check compiles its likelihood (seconds for a full-Mueller model), which a worker process
         compiles again, and a candidate whose maximum is known already may never be evaluated here at all. Not kept
         either: 61 compiled candidate posteriors held in one process made every later evaluation 1.3x slower
         (Python's collector walking twice the objects), more than their compilations would cost again."""

@@ -1,8 +1,7 @@
 """emcee's HDF5 backend, written every ``every`` steps instead of every step.
 
-h5py opens the file, checks it and writes five attributes for each step: 2 ms per step, more than an
-emcee step of a small likelihood itself (PTFE in-plane, 32 walkers: 1.7 ms per step in memory, 3.7 ms
-with the per-step backend). Here steps wait in memory and go to the file in one write of ``every`` rows,
+h5py opens the file, checks it and writes five attributes for each step, which costs more than an emcee step
+of a small likelihood itself (``benchmarks/inversion_speed.py``). Here steps wait in memory and go to the file in one write of ``every`` rows,
 with the random state of the last of them; the chain is also written before it is read (autocorrelation,
 reports) and by ``flush()``. A kill loses at most the steps since the last write: the file always holds a
 consistent chain and the random state that continues it, so the same command resumes it and gives the

@@ -36,8 +36,8 @@ def convergence(idata, result: EngineResult) -> dict:
 def loo(idata) -> dict:
     """PSIS-LOO of the draws in ``idata`` (its log_likelihood group, variable "y"): ``loo_fields``' record, as
     ``arviz.loo`` computes it (the relative efficiency from the posterior group's mean ESS where there are several
-    chains; then ``psis.psis_log_weights``, ArviZ's smoothing vectorised over the observations: ArviZ's own loop
-    took 1-4 s of each refit on a 4,448-number set). Where PSIS fails for an observation, its in-sample log
+    chains; then ``psis.psis_log_weights``, ArviZ's smoothing vectorised over the observations, where ArviZ's own
+    loop over them is slow on large data sets). Where PSIS fails for an observation, its in-sample log
     predictive density stands in and its Pareto k is set to inf."""
     ll = idata.log_likelihood["y"].transpose("obs_id", "chain", "draw").values
     ll = ll.reshape(ll.shape[0], -1)  # (M, S): ArviZ's stacking of (chain, draw)

@@ -17,7 +17,7 @@ from .engine_result import EngineResult
 _POINTWISE_VALUES = 40_000_000
 _MIN_POINTWISE_DRAWS = 800
 # a posterior median prediction from at most this many evenly thinned draws: its Monte-Carlo error is then below
-# 4 % of the posterior SD, and on a 278-geometry full-Mueller set each median took 1.6 s from 9,000 draws
+# 4 % of the posterior SD, and more draws only cost time
 _MEDIAN_DRAWS = 1000
 
 
@@ -42,7 +42,7 @@ def model_dop(posterior: Posterior, flat_theta, draws: int = 200) -> np.ndarray:
     """Posterior-median model DOP at the data's geometries, also where DOP is not fitted (a Mueller fit
     predicts it from its first column): (N,). Up to ``draws`` evenly thinned samples. Evaluated by the program
     that ``predictive_means`` compiled already (the same outputs and batch size): a DOP-only program of its own
-    cost one more compilation per fit, 1.3 s on a 278-geometry full-Mueller set."""
+    would cost one more compilation per fit."""
     lik = posterior.likelihood
     params = posterior.model_params(flat_theta[:: max(1, len(flat_theta) // draws)])
     prediction = lik.model.evaluate(params, lik.geometry, mueller=lik.needs_mueller, check=False)

@@ -28,16 +28,13 @@ from ..physics.parameter import Parameter
 
 _CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
 # the only batch sizes compiled: an emcee half-ensemble, a DE generation, larger batches in blocks; every other
-# size would be a compilation of its own (0.05-1 s each, ~10 per model in a diagnose screening before this).
-# Blocks above 256 sets only where ``batch_sets`` allows them (small data sets): a call has a fixed cost of
-# ~50-150 us, more than 256 sets of the paper's 84-point DOP take (4,096 sets: 140 M evaluations/s in blocks
-# of 256, 274-314 in blocks of 1,024, 357-524 in one block, interleaved in one process)
+# size would be a compilation of its own. Blocks above 256 sets only where ``batch_sets`` allows them (small data
+# sets): a call's fixed cost exceeds what 256 sets of a small DOP set take (``benchmarks/forward_speed.py``)
 _BATCH_SIZES = (16, 64, 256, 1024, 4096)
 _ALWAYS_UP_TO = 256
 # a likelihood whose smallest block (16 sets) holds at least this many numbers is compiled for that block and the
-# caller's exact sizes only: each compilation of a full-Mueller program costs 2-5 s on a 2-core machine (PTFE-like,
-# 325 geometries x 16 elements: 6 sizes per model, ~27 s, of a diagnose candidate's ~40 s), while a call of 16 sets
-# takes milliseconds, so the fixed cost of more calls is lost in it
+# caller's exact sizes only: a compilation of a full-Mueller program costs more than many calls of 16 sets, so
+# the fixed cost of more calls is lost in it
 _ONE_BLOCK_NUMBERS = 1 << 15
 # ``total`` reads a large likelihood's pointwise program where a call's block holds at most this many numbers: beyond
 # it the unfused values no longer stay in the cache (all of PTFE, 7,296 geometries x 16 elements, ``paper`` at four
@@ -197,9 +194,8 @@ class Likelihood:
     def total(self, params: dict) -> np.ndarray:
         """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept); on a
         large data set (``compiles_one_block``), where a call's block holds at most ``_POINTWISE_NUMBERS`` numbers,
-        the sum of ``pointwise``, so that a model compiles one likelihood program, not two (PTFE, 278 full-Mueller
-        geometries, 16 sets: both take 0.8-2.2 ms a call and 1.5-4.5 s to compile, and every model diagnose refits
-        needs the pointwise one too)."""
+        the sum of ``pointwise``, so that a model compiles one likelihood program, not two (a call of either costs
+        far less than a compilation, and every model diagnose refits needs the pointwise one too)."""
         return self._call(1, params)
 
     @property
@@ -363,8 +359,7 @@ class Likelihood:
 
 def _in_cache_sized_chunks(summed, numbers_per_set: int):
     """``summed`` over a (P, D) matrix in chunks of sets small enough that the sets x geometries intermediates stay
-    in the CPU's cache: above it the evaluation is memory-bound (PTFE's 1,824 x 16 numbers: 10.5 M/s at 16 sets, 4.2
-    at 64)."""
+    in the CPU's cache: above it the evaluation is memory-bound."""
 
     def total(matrix):
         n_sets = matrix.shape[0]

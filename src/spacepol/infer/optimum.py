@@ -64,10 +64,9 @@ def candidates(posterior: Posterior, rng: np.random.Generator, evaluations: int 
     return found
 
 
-# screening's polishes (its own and DE's) stop where a step changes the log posterior by < 1e-7 of its value (~1e-3
-# on PTFE's 4,448 numbers). Measured on PTFE, `add volume` to a 13-parameter model: scipy's default 2.2e-9 16.4 s,
-# gain 32.1; 1e-8 10.1 s, 32.1; 1e-7 2.7 s, 26.3. A screening gain is a lower bound, here by ~6 units; it only
-# ranks the candidates, and the leaders are searched again and refitted with the default tolerance
+# screening's polishes (its own and DE's) stop where a step changes the log posterior by < 1e-7 of its value, a
+# fraction of scipy's default's time. A screening gain is then a lower bound by a few units; it only ranks the
+# candidates, and the leaders are searched again and refitted with the default tolerance
 SCREEN_FTOL = 1e-7
 
 

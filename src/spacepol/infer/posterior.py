@@ -137,7 +137,7 @@ class Posterior:
 class PinnedPosterior(Posterior):
     """``parent`` with some of its free parameters held at values (an effect's branch, e.g. a dielectric's k = 0),
     over the others (``priors``: the parent's with those parameters fixed). Evaluated through the parent's compiled
-    program with the held values as columns: held as constants they would compile a program of their own (1.5-2.5 s
+    program with the held values as columns: held as constants they would compile a program of their own (seconds
     for a full-Mueller model, paid by every screened candidate)."""
 
     def __init__(self, parent: Posterior, priors: PriorSet, pinned: dict):

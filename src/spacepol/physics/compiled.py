@@ -44,7 +44,7 @@ def degree_of_polarization(stokes, polarized=None):
 
 def bucket(n_sets: int) -> int:
     """Parameter sets are padded to a power of two: one compiled program per octave of batch sizes
-    (a compilation costs 0.2-2 s, more than the padded sets do; ``Likelihood.batch_sets`` is one too)."""
+    (a compilation costs more than the padded sets do; ``Likelihood.batch_sets`` is one too)."""
     return 1 << max(0, (n_sets - 1).bit_length())
 
 

@@ -1,7 +1,7 @@
 """Grids of panels with a fixed layout.
 
 Constrained layout measures every tick label of every panel on every draw: on the tens of panels of a
-full-Mueller fit it cost three times the drawing itself (fit.png: 17 s of a 60 s PTFE report). A grid of
+full-Mueller fit it costs several times the drawing itself. A grid of
 like panels needs no solver: margins and gaps in inches leave room for the labels.
 """
 

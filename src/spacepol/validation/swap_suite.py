@@ -1,4 +1,4 @@
-"""Validation of diagnose --rounds where the paper's model is wrong in parts (issue 10).
+"""Validation of diagnose --rounds where the paper's model is wrong in parts.
 
 Data come from ``specular+smith+lambertian`` (reciprocal, physical shadowing and diffuse terms) plus
 one hidden effect E, or none; diagnose starts from ``paper`` (empirical shadowing, non-reciprocal

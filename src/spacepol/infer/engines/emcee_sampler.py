@@ -19,8 +19,8 @@ from .snooker import DESnookerMove
 
 
 def default_walkers(ndim: int) -> int:
-    """32 walkers up to 8 parameters (measured: on the 84-point paper DOP set 32 walkers reach
-    R-hat <= 1.01 in 6000-9000 steps at ~2 ms/step, 128 walkers in 6000 steps at ~3.5 ms/step)."""
+    """32 walkers up to 8 parameters, then 4 per parameter: on small problems more walkers converge in no fewer
+    steps and cost more per step (``benchmarks/inversion_speed.py``)."""
     return max(32, 2 * ((4 * ndim + 1) // 2))
 
 

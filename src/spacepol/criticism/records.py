@@ -161,13 +161,64 @@ class DiagnosisRecord(_JSONView):
         return {**self.content, "ranking": [e.to_json() for e in self.content["ranking"]]}
 
 
+@dataclass(frozen=True, eq=False)
+class RoundStep(Mapping):
+    """One step of the path of ``diagnose --rounds``, immutable: the model after it and the ``change`` that made it
+    (None for the start) with its delta ELPD-LOO and SE, the changes ``tied_with`` it and the ``alternatives``
+    refitted beside it, the fit and the inferred against the measured noise, the residual structure and parameters at
+    a bound; whether the change was a ``simplification`` (fewer parameters, predicting as well); on the final step,
+    the slot members ``equivalent`` to the model's and those significantly ``better``. Reads like its JSON entry."""
+
+    model: str
+    change: str | None
+    delta_elpd: float | None
+    delta_elpd_se: float | None
+    tied_with: tuple
+    alternatives: tuple
+    fit: dict
+    inferred_noise: dict
+    noise: dict
+    residual_structure: tuple
+    structured: bool
+    at_bound: tuple
+    simplification: bool | None = None
+    equivalent: tuple | None = None
+    better: tuple | None = None
+
+    def to_json(self) -> dict:
+        """The step as the rounds' JSON record holds it."""
+        out = {"model": self.model, "change": self.change, "delta_elpd": self.delta_elpd,
+               "delta_elpd_se": self.delta_elpd_se, "tied_with": list(self.tied_with),
+               "alternatives": list(self.alternatives), "fit": self.fit, "inferred_noise": self.inferred_noise,
+               "noise": self.noise, "residual_structure": list(self.residual_structure), "structured": self.structured,
+               "at_bound": list(self.at_bound)}
+        if self.simplification is not None:
+            out["simplification"] = self.simplification
+        if self.equivalent is not None:
+            out |= {"equivalent": list(self.equivalent), "better": list(self.better or ())}
+        return out
+
+    def __getitem__(self, key):
+        return self.to_json()[key]
+
+    def __iter__(self):
+        return iter(self.to_json())
+
+    def __len__(self):
+        return len(self.to_json())
+
+
 @dataclass(eq=False)
 class RoundsRecord(_JSONView):
-    """``diagnose --rounds``: ``content`` (the JSON record: the path of changes with the fit after each, the verdict,
-    the last round's ranking) and each round's DiagnosisRecord (``reports``)."""
+    """``diagnose --rounds``: ``content`` (the record: the path of ``RoundStep``s with the fit after each, the
+    verdict, the last round's ranking) and each round's DiagnosisRecord (``reports``)."""
 
     content: dict
     reports: list[DiagnosisRecord]
+
+    def to_json(self) -> dict:
+        """The record as JSON (what ``--json`` and the report files hold)."""
+        return {**self.content, "rounds": [step.to_json() for step in self.content["rounds"]]}
 
 
 @dataclass(eq=False)

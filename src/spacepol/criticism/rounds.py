@@ -6,6 +6,7 @@ residual structure, so a user sees the error fall round by round and whether the
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 import numpy as np
 
@@ -16,16 +17,16 @@ from .candidate_fits import CandidateFits
 from .criteria import significant
 from .diagnose import diagnose
 from .explain import structured
-from .records import CandidateFit, DiagnosisRecord, RoundsRecord, Rung
+from .records import CandidateFit, DiagnosisRecord, RoundStep, RoundsRecord, Rung
 from ..infer.run_summary import RunSummary
 
 
-def _step(summary: RunSummary, change=None, delta=None, se=None, tied=(), alternatives=()) -> dict:
-    return {"model": summary.model, "change": change, "delta_elpd": delta, "delta_elpd_se": se, "tied_with": list(tied),
-            "alternatives": list(alternatives),
-            "fit": summary.fit, "inferred_noise": inferred_noise_levels(summary), "noise": summary.noise,
-            "residual_structure": summary.residual_structure["findings"],
-            "structured": bool(structured(summary)), "at_bound": summary.at_bound}
+def _step(summary: RunSummary, change=None, delta=None, se=None, tied=(), alternatives=(),
+          simplification: bool | None = None) -> RoundStep:
+    """The path's step to the model ``summary`` describes."""
+    return RoundStep(summary.model, change, delta, se, tuple(tied), tuple(alternatives), summary.fit,
+                     inferred_noise_levels(summary), summary.noise, tuple(summary.residual_findings),
+                     bool(structured(summary)), tuple(summary.at_bound), simplification)
 
 
 def as_rungs(result: RoundsRecord) -> list[Rung]:
@@ -75,17 +76,17 @@ def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progre
         if report["verdict"] == "none":
             simplification = _simplification(report)
             if simplification is None:
-                path[-1]["equivalent"], path[-1]["better"] = _slot_equivalents(
-                    data, current, rng, seed, observables, candidates, progress, priors, report.base, posterior_method,
-                    searched, fits)
+                equivalent, better = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
+                                                       priors, report.base, posterior_method, searched, fits)
+                path[-1] = replace(path[-1], equivalent=tuple(equivalent), better=tuple(better))
                 break
         lead = simplification or next(c for c in report.confirmed if c.verdict == report["verdict"])
         # the other changes refitted in this round, so the path shows what the chosen one was weighed against
         alternatives = [{k: e[k] for k in ("change", "delta_elpd", "delta_elpd_se", "significant")}
                         for e in report["ranking"] if e["delta_elpd"] is not None and e["change"] != lead.label]
         path.append(_step(lead.inversion.summary, lead.label, lead.delta_elpd, lead.delta_elpd_se,
-                          [] if simplification else report["ranking"][0].get("tied_with", []), alternatives))
-        path[-1]["simplification"] = simplification is not None
+                          [] if simplification else report["ranking"][0].get("tied_with", []), alternatives,
+                          simplification is not None))
         current, base = lead.model, lead.inversion
         if progress:
             print(f"  round {r + 1}: {lead.label} (delta ELPD {lead.delta_elpd:+.1f} +- {lead.delta_elpd_se:.1f}); "
@@ -153,7 +154,7 @@ def _better(report: DiagnosisRecord, labels) -> list[dict]:
     return sorted(out, key=lambda e: -e["delta_elpd"])
 
 
-def _conclusion(path: list[dict], reports: list[DiagnosisRecord]) -> str:
+def _conclusion(path: list[RoundStep], reports: list[DiagnosisRecord]) -> str:
     final = path[-1]
     changes = [p["change"] + (" (simpler, predicts as well)" if p.get("simplification") else "") for p in path[1:]]
     route = " -> ".join([path[0]["model"]] + changes) if changes else path[0]["model"]

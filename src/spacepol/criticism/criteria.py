@@ -46,8 +46,9 @@ class Criterion:
         """(ln Z, error) of a fit where its engine gave one, else None."""
         return result.log_evidence
 
-    def judge(self, change) -> None:
-        """Set ``change.significant`` by this criterion (ELPD-LOO's verdict is set by the refit)."""
+    def judged(self, change) -> dict:
+        """The fields this criterion sets on a refitted change (ELPD-LOO's verdict is the refit's own)."""
+        return {}
 
     def order(self, change) -> float:
         """The sort key of a refitted change, best first."""
@@ -70,9 +71,9 @@ class Evidence(Criterion):
         """(ln Z, error): the fit's own, else nested sampling's on the same posterior."""
         return evidence_of(result, posterior, seed)
 
-    def judge(self, change) -> None:
+    def judged(self, change) -> dict:
         """Significant by the Bayes factor."""
-        change.significant = significant_evidence(change.delta_log_evidence, change.delta_log_evidence_error)
+        return {"significant": significant_evidence(change.delta_log_evidence, change.delta_log_evidence_error)}
 
     def order(self, change) -> float:
         """By ln Bayes factor."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -66,6 +66,12 @@ class _Run:
     base_best: float = 0.0
     base_optimum: dict = None
     blind: list = field(default_factory=list)
+    board: dict = field(default_factory=dict)  # {change label: its CandidateFit as it stands}
+
+    def update(self, label: str, **fields) -> CandidateFit:
+        """The change ``label``'s record with ``fields`` replaced (records are immutable): the new one."""
+        self.board[label] = replace(self.board[label], **fields)
+        return self.board[label]
 
     def say(self, text: str) -> None:
         """A progress line with the seconds since the start, where progress is on."""
@@ -115,7 +121,7 @@ def diagnose(data, model: Model, rng: np.random.Generator, seed: int = 0, observ
     screened = _screen(run, all_candidates)
     to_confirm = _select(run, screened, top, simplifications)
     confirmed = _refit(run, to_confirm)
-    return _explain(run, model, screened, _rank(run, confirmed))
+    return _explain(run, model, screened, _rank(run, confirmed))  # each stage: change labels; ``run.board`` the records
 
 
 def _fit_base(run: _Run, model: Model, base, candidates) -> list:
@@ -140,9 +146,9 @@ def _fit_base(run: _Run, model: Model, base, candidates) -> list:
     return [c for c in all_candidates if c not in run.blind]
 
 
-def _screen(run: _Run, all_candidates: list) -> list[CandidateFit]:
+def _screen(run: _Run, all_candidates: list) -> list[str]:
     """Every change's maximum log posterior (searched near the base's optimum, or known from ``run.searched``) and
-    its gain over the base's, best first."""
+    its gain over the base's: the changes' labels, best first."""
     run.say(f"[base] done; screening {len(all_candidates)} candidate effects")
     if run.blind:
         run.say(f"[screen] not screened: {', '.join(c.label for c in run.blind)} ({BLIND_REASON})")
@@ -163,79 +169,95 @@ def _screen(run: _Run, all_candidates: list) -> list[CandidateFit]:
         run.searched[model_key(all_candidates[unsearched[j]].model)] = found
         done += 1
         screened_line(unsearched[j], done)
-    screened = []
     for change, post in zip(all_candidates, posteriors):
         best, optimum = run.searched[model_key(change.model)]
-        screened.append(CandidateFit(change, post, float(best - run.base_best), _vector(optimum, post)))
-    screened.sort(key=lambda c: -c.screening_gain)
+        run.board[change.label] = CandidateFit(change, post, float(best - run.base_best), _vector(optimum, post))
     run.clock["screening"] = time.perf_counter()
-    return screened
+    return sorted(run.board, key=lambda label: -run.board[label].screening_gain)
 
 
-def _select(run: _Run, screened: list, top: int, simplifications: int) -> list[CandidateFit]:
+def _select(run: _Run, screened: list[str], top: int, simplifications: int) -> list[str]:
     """The changes to refit: the ``top`` screened and their equals, the twins of an addition among them (where the
     fitted observables do not separate the two), the changes asked for (``confirm``) and ``simplifications`` changes
     with fewer free parameters; each starts from the best of its screening and a global multistart. A change asked
     for whose optimum alone decides (``_plugin_decides``) is not refitted."""
+    board = run.board
+    gain = {label: board[label].screening_gain for label in screened}
     # a candidate whose screening gain equals the leader's may be its twin: confirm it too
-    to_confirm = screened[:top] + [c for c in screened[top:] if top and _close(c.screening_gain, screened[0].screening_gain)]
+    chosen = screened[:top] + [c for c in screened[top:] if top and _close(gain[c], gain[screened[0]])]
     # effects declared twins of a confirmed addition are refitted too: a tie can only be seen between two fits; not
     # where the fitted observables separate the two (``Effect.separated_by``: the full Mueller matrix for an analyser
     # and depolarized light), where the twin is refitted only if its own screening earns it
     fitted = set(run.base_post.likelihood.observable_names)
-    twins = {t for c in to_confirm if c.kind == "add" for t in registry.get(c.effect).twins
-             if not fitted & set(separating_observables(c.effect, t))}
-    to_confirm += [c for c in screened if c not in to_confirm and c.kind == "add" and c.effect in twins]
-    to_confirm += [c for c in screened if c not in to_confirm and c.label in run.confirm]
+    twins = {t for c in chosen if board[c].kind == "add" for t in registry.get(board[c].effect).twins
+             if not fitted & set(separating_observables(board[c].effect, t))}
+    chosen += [c for c in screened if c not in chosen and board[c].kind == "add" and board[c].effect in twins]
+    chosen += [c for c in screened if c not in chosen and c in run.confirm]
     # the best simplifications (fewer free parameters) that screening does not rule out: if nothing is
     # significant, diagnose --rounds takes one that predicts as well (Occam)
-    simpler = [c for c in screened if c not in to_confirm and c.posterior.ndim < run.base_post.ndim
-               and c.screening_gain > -2 * MIN_DELTA_ELPD]
-    to_confirm += simpler[:simplifications]
+    simpler = [c for c in screened if c not in chosen and board[c].posterior.ndim < run.base_post.ndim
+               and gain[c] > -2 * MIN_DELTA_ELPD]
+    chosen += simpler[:simplifications]
     # screening searched near the base model; a refit starts from the best of that and a global multistart
-    leaders = dict(run.fits.run("leader", [(c.model, c.posterior) for c in to_confirm], run.rng))
-    for i, c in enumerate(to_confirm):
+    leaders = dict(run.fits.run("leader", [(board[c].model, board[c].posterior) for c in chosen], run.rng))
+    for i, label in enumerate(chosen):
         value, theta = leaders[i]
-        if value > c.screening_gain + run.base_best:
-            c.screening_gain, c.optimum = float(value - run.base_best), theta
+        if value > gain[label] + run.base_best:
+            c = run.update(label, screening_gain=float(value - run.base_best), optimum=theta)
             run.searched[model_key(c.model)] = value, dict(zip(c.posterior.priors.names, theta))
     # changes refitted only because the caller asked (the slot alternatives diagnose --rounds weighs at its end)
     # and that their optima alone already show to differ significantly are not refitted
-    asked = [c for c in to_confirm if c.label in run.confirm]
+    asked = [c for c in chosen if c in run.confirm]
+    decided = set()
     if asked:
         best = np.array([run.base.draws.best[n] for n in run.base_post.priors.names], float)
         base_pointwise = run.base_post.log_prob_pointwise(best[None, :])[0]
-    decided = [c for c in asked if _plugin_decides(c, base_pointwise, float(run.base.loo.get("p_loo", 0.0)))]
+        for label in asked:
+            found = _plugin_decides(board[label], base_pointwise, float(run.base.loo.get("p_loo", 0.0)))
+            if found:
+                run.update(label, **found)
+                decided.add(label)
     run.clock["leaders"] = time.perf_counter()
-    return [c for c in to_confirm if c not in decided]
+    return [c for c in chosen if c not in decided]
 
 
-def _refit(run: _Run, to_confirm: list) -> list[CandidateFit]:
+def _refit(run: _Run, to_confirm: list[str]) -> list[str]:
     """The selected changes refitted (their posteriors, pointwise ELPD-LOO and signatures), the best screened
     first; one the best refit so far shows clearly worse (``_dominated``, where the criterion allows) is not refitted
     but weighed again against the final front-runner. Returns the refitted ones."""
+    board = run.board
     if to_confirm:
-        run.say(f"[confirm] refitting {len(to_confirm)}: {', '.join(c.label for c in to_confirm)}")
+        run.say(f"[confirm] refitting {len(to_confirm)}: {', '.join(to_confirm)}")
     # start at the screening optimum: multimodal candidates (film thickness) keep the mode screening found; the
     # best screened first, so that candidates its refit shows to be clearly worse need no refit of their own
-    to_confirm = sorted(to_confirm, key=lambda c: -c.screening_gain)
+    to_confirm = sorted(to_confirm, key=lambda label: -board[label].screening_gain)
     base_fit = median_fit(run.base.posterior, run.base.draws.flat_samples())
     refitted, dominated = [], []
 
     def refit(batch: list) -> None:
-        jobs = [(c.model, c.posterior, c.optimum, run.seed, run.max_steps, run.posterior_method) for c in batch]
+        jobs = [(board[c].model, board[c].posterior, board[c].optimum, run.seed, run.max_steps, run.posterior_method)
+                for c in batch]
         for i, inv in run.fits.run("refit", jobs, run.rng):
-            _record_refit(batch[i], inv, run.base, base_fit, run.base_loo)
+            run.update(batch[i], **_refit_fields(inv, run.base, base_fit, run.base_loo))
             refitted.append(batch[i])
-            run.say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {batch[i].label}: "
+            run.say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {batch[i]}: "
                     f"{posterior_words(inv)}, {inv.summary.seconds:.0f} s")
+
+    def front_runner():
+        return _front_runner([board[c] for c in refitted])
+
+    def clearly_worse(label: str, lead) -> bool:
+        found = _dominated(board[label], lead) if lead is not None else None
+        if found:
+            run.update(label, **found)
+        return bool(found)
 
     def weigh(pending: list) -> list:
         """``pending`` less those the best refit so far shows clearly worse (not the changes asked for)."""
-        lead = _front_runner(refitted) if run.criterion.skips_dominated else None
-        skip = [c for c in pending if lead is not None and c.label not in run.confirm and _dominated(c, lead)]
+        lead = front_runner() if run.criterion.skips_dominated else None
+        skip = [c for c in pending if c not in run.confirm and clearly_worse(c, lead)]
         if skip:
-            run.say(f"[confirm] not refitted, clearly worse than {lead.label}: {', '.join(c.label for c in skip)}")
+            run.say(f"[confirm] not refitted, clearly worse than {lead.label}: {', '.join(skip)}")
         dominated.extend(skip)
         return [c for c in pending if c not in skip]
 
@@ -244,51 +266,53 @@ def _refit(run: _Run, to_confirm: list) -> list[CandidateFit]:
     refit(to_confirm[:1])
     refit(weigh(to_confirm[1:]))
     while dominated:
-        again = [c for c in dominated if _front_runner(refitted) is None or not _dominated(c, _front_runner(refitted))]
+        again = [c for c in dominated if front_runner() is None or not clearly_worse(c, front_runner())]
         if not again:
             break
         dominated[:] = [c for c in dominated if c not in again]
         refit(again)
     for c in dominated:
-        c.dominated_by = _front_runner(refitted).label
+        run.update(c, dominated_by=front_runner().label)
     return [c for c in to_confirm if c not in dominated]
 
 
-def _record_refit(c: CandidateFit, inv, base, base_fit, base_loo) -> None:
+def _refit_fields(inv, base, base_fit, base_loo) -> dict:
     """A refit's Result, pointwise ELPD-LOO, difference to the base with its SE, signatures and significance."""
     diff = inv.loo["pointwise"] - base_loo
-    c.inversion, c.pointwise = inv, inv.loo["pointwise"]
-    c.delta_elpd, c.delta_elpd_se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
-    c.rmse_dop_after, c.signatures = inv.summary.fit["rmse_dop"], signatures(base, inv, base_fit)
-    c.significant = significant(c.delta_elpd, c.delta_elpd_se)
+    delta, se = float(diff.sum()), float(np.sqrt(len(diff) * np.var(diff)))
+    return {"inversion": inv, "pointwise": inv.loo["pointwise"], "delta_elpd": delta, "delta_elpd_se": se,
+            "rmse_dop_after": inv.summary.fit["rmse_dop"], "signatures": signatures(base, inv, base_fit),
+            "significant": significant(delta, se)}
 
 
-def _rank(run: _Run, confirmed: list) -> list[CandidateFit]:
+def _rank(run: _Run, confirmed: list[str]) -> list[CandidateFit]:
     """The refitted changes by the criterion, best first, each with its ln Bayes factor where the evidence is known;
     among the significant changes tied with the best, the one with the fewest free parameters leads."""
     base_evidence = run.criterion.evidence(run.base, run.base_post, run.seed)
-    for c in confirmed:
+    for label in confirmed:
+        c = run.board[label]
         own = run.criterion.evidence(c.inversion, c.posterior, run.seed)
         if own is not None and base_evidence is not None:
-            c.delta_log_evidence = own[0] - base_evidence[0]
-            c.delta_log_evidence_error = float(np.hypot(own[1], base_evidence[1]))
-        run.criterion.judge(c)
-    confirmed = sorted(confirmed, key=run.criterion.order)
-    if confirmed and confirmed[0].significant:
+            c = run.update(label, delta_log_evidence=own[0] - base_evidence[0],
+                           delta_log_evidence_error=float(np.hypot(own[1], base_evidence[1])))
+        run.update(label, **run.criterion.judged(c))
+    ranked = sorted((run.board[label] for label in confirmed), key=run.criterion.order)
+    if ranked and ranked[0].significant:
         # changes that fit equally well (tied with the best): the one with fewer free parameters leads
-        group = [c for c in confirmed if c.significant and (c is confirmed[0] or tied(confirmed[0], c))]
+        group = [c for c in ranked if c.significant and (c is ranked[0] or tied(ranked[0], c))]
         simplest = min(group, key=lambda c: (c.posterior.ndim, -c.delta_elpd))
-        confirmed.remove(simplest)
-        confirmed.insert(0, simplest)
+        ranked.remove(simplest)
+        ranked.insert(0, simplest)
     run.clock["confirmation"] = time.perf_counter()
-    return confirmed
+    return ranked
 
 
 def _explain(run: _Run, model: Model, screened: list, confirmed: list) -> DiagnosisRecord:
     """The diagnosis: a ranking entry per refitted change (``refitted_entry``) and per change screened out or not
     refitted (``unrefitted_entry``), the verdict with its ties, the conclusion, and where the time went."""
     ranking = [refitted_entry(c, run.base, run.criterion.note) for c in confirmed]
-    ranking += [unrefitted_entry(c) for c in screened if c not in confirmed]
+    done = {c.label for c in confirmed}
+    ranking += [unrefitted_entry(run.board[label]) for label in screened if label not in done]
     verdict = "none"
     if confirmed and confirmed[0].significant:
         verdict = confirmed[0].verdict
@@ -325,25 +349,24 @@ def _same_posterior(result, posterior) -> bool:
             and own.priors.describe() == posterior.priors.describe())
 
 
-# the standard error of a difference of pointwise log likelihoods at two optima, widened by this factor before it
-# stands in for the LOO difference's (on PTFE's eight slot alternatives the LOO SE was 1.02-1.12 times it)
+# the SE of a difference of pointwise log likelihoods at two optima, widened thus to stand in for the LOO difference's
 PLUGIN_SE_SLACK = 1.25
 
 
-def _plugin_decides(c: CandidateFit, base_pointwise: np.ndarray, base_p_loo: float) -> bool:
+def _plugin_decides(c: CandidateFit, base_pointwise: np.ndarray, base_p_loo: float) -> dict | None:
     """Whether candidate ``c`` differs from the base so clearly that its refit cannot change the verdict: the pointwise
     log likelihood at its optimum minus the base's at the base's best draw (``base_pointwise``) sums to d with standard error s, and
     |d| - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = the base's p_loo + 2 x the candidate's free
     parameters (``base_p_loo``; ELPD-LOO = plug-in log likelihood - p_loo; the margin bounds the change in p_loo). On PTFE at 0.633 um
     (278 geometries, the eight slot alternatives of a five-effect model) the plug-in sums were within 17 of the
-    refitted delta ELPD-LOO, whose p_loo changed by up to 26. Records the figures in ``c`` when it decides."""
+    refitted delta ELPD-LOO, whose p_loo changed by up to 26. Returns the figures (``c``'s fields) where it decides,
+    else None."""
     d = c.posterior.log_prob_pointwise(c.optimum[None, :])[0] - base_pointwise
     delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
     margin = base_p_loo + 2.0 * c.posterior.ndim
     if abs(delta) - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
-        c.plugin_delta, c.plugin_se, c.plugin_margin = delta, se, margin
-        return True
-    return False
+        return {"plugin_delta": delta, "plugin_se": se, "plugin_margin": margin}
+    return None
 
 
 def _front_runner(refitted: list):
@@ -355,21 +378,20 @@ def _front_runner(refitted: list):
     return best
 
 
-def _dominated(c: CandidateFit, lead: CandidateFit) -> bool:
+def _dominated(c: CandidateFit, lead: CandidateFit) -> dict | None:
     """Whether candidate ``c`` is so clearly worse than the refitted ``lead`` that its refit could neither make it
     lead nor tie: the lead's pointwise ELPD-LOO minus c's pointwise log likelihood at its optimum sums to d with
     standard error s, and d - margin > 2 s x PLUGIN_SE_SLACK and > 4 + margin, margin = 2 x c's free parameters.
     The plug-in log likelihood stands above c's ELPD-LOO (by about its effective number of parameters, p_loo, for a
     regular posterior), so d understates how much worse c predicts; the margin covers a posterior whose LOO density
     exceeds its plug-in one. Its refit starts at the same optimum, so it would weigh the same mode.
-    Records the figures in ``c`` when it decides."""
+    Returns the figures (``c``'s fields) where it decides, else None."""
     d = lead.pointwise - c.posterior.log_prob_pointwise(c.optimum[None, :])[0]
     delta, se = float(d.sum()), float(np.sqrt(len(d) * np.var(d)))
     margin = 2.0 * c.posterior.ndim
     if delta - margin > max(2.0 * PLUGIN_SE_SLACK * se, MIN_DELTA_ELPD):
-        c.dominance_delta, c.dominance_se, c.dominance_margin = delta, se, margin
-        return True
-    return False
+        return {"dominance_delta": delta, "dominance_se": se, "dominance_margin": margin}
+    return None
 
 
 def _say(text: str) -> None:

@@ -30,7 +30,7 @@ class _JSONView(Mapping):
         return self.content
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class CandidateFit:
     """One change of a model as diagnose weighs it: the change (``criticism.changes.Change``), its posterior,
     its screening gain (max log posterior over the base model's) and optimum, and once refitted its Result

@@ -53,9 +53,12 @@ def test_the_check_finds_a_session_number(tmp_path):
 
 ISSUE = re.compile(r"\bissue\s+#?\d+", re.IGNORECASE)
 # a run's time quoted in a comment or docstring: "took 12 s", "1.5-4 s", "2 ms per step", "10 M/s"
-TIMING = re.compile(r"(?<![\w.^-])\d+(?:\.\d+)?(?:-\d+(?:\.\d+)?)? ?(?:ms|s|min)\b(?![\^\-]1)|\bM/s\b")
+TIMING = re.compile(r"(?<![\w.^-])\d+(?:\.\d+)?(?:-\d+(?:\.\d+)?)? ?(?:ms|us|s|min)\b(?!\^)|\bM/s\b")
 # physical quantities, not run times: an exposure, a unit example, a standard error s, a fit parameter, UT1-UTC
-PHYSICAL = ("1 s exposure", '"25 ms"', "2 s x PLUGIN", "3.13 s exp", "0.9 s by", "running 5 s after")
+PHYSICAL = ("1 s exposure", '"25 ms"', "2 s x PLUGIN", "3.13 s exp", "0.9 s by", "running 5 s after",
+            "5 us for this pass", "20 s steps", ":10s}")
+# the pages that carry measured figures, dated
+MEASUREMENT_PAGES = ("benchmarks.md", "benchmarks-log.md", "changelog.md")
 
 
 def _comments_and_docstrings(path: Path) -> list[tuple[int, str]]:
@@ -92,3 +95,10 @@ def test_the_timing_check_sees_a_quoted_run_time():
     assert quoted_times("Fast (issue 12).") == ["issue 12"]
     assert quoted_times("# the fit took 12.5 s on PTFE, 2 ms per step") == ["12.5 s", "2 ms"]
     assert quoted_times("# photons m^-2 s^-1 at 30 deg") == []
+
+
+def test_no_run_times_in_the_readme_or_the_docs_but_the_measurement_pages():
+    pages = [ROOT / "README.md"] + [p for p in sorted((ROOT / "docs").glob("*.md")) if p.name not in MEASUREMENT_PAGES]
+    found = [f"{page.relative_to(ROOT)}:{i}: {hit}" for page in pages
+             for i, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1) for hit in quoted_times(line)]
+    assert found == []

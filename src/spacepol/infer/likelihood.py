@@ -213,8 +213,8 @@ class Likelihood:
         return out[:, 0], {name: out[:, 1 + j] for j, (name, _, _) in enumerate(levels)}
 
     def _call(self, which: int, params: dict, levels: tuple = ()) -> np.ndarray:
-        """Parameter sets go in as one (P, K) matrix (one argument: a JAX call with a dict of arrays costs
-        ~100 us of argument handling, more than the 84-point likelihood itself); scalars are compiled in."""
+        """Parameter sets go in as one (P, K) matrix (one argument: a JAX call with a dict of arrays spends
+        more on argument handling than a small likelihood itself takes); scalars are compiled in."""
         columns, scalars, n_sets = [], {}, 0
         for name, v in params.items():
             if np.ndim(v) == 0:

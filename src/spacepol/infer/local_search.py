@@ -4,8 +4,7 @@ are not the posterior, e.g. the paper's eq 25).
 
 scipy's own finite differences call the objective once per parameter, each call a separate model
 evaluation of one parameter set; the model is vectorised over parameter sets, so evaluating the point
-and its D neighbours as one batch of D + 1 rows costs about as much as one row (measured on the paper
-model, 84 points: 1 row 52 us, 8 rows 65 us). Forward differences with scipy's step (sqrt of machine
+and its D neighbours as one batch of D + 1 rows costs about as much as one row on a small data set. Forward differences with scipy's step (sqrt of machine
 epsilon), taken backwards at the upper bound.
 """
 

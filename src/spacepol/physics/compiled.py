@@ -52,7 +52,7 @@ def packed(values: dict, n_sets: int) -> np.ndarray:
     """The given values as one array, columns in ``values``' order: (bucket(n_sets), K) for parameter sets
     ((n_sets, 1) arrays; a scalar is repeated), padded by repeating the last set (always a valid one), or (K,)
     for scalars alone. One argument: the call then hands one buffer to the program instead of one per
-    parameter (paper's DOP, 4,096 x 84: 30 us of a 500 us call)."""
+    parameter, a noticeable share of a small call."""
     if not n_sets:
         return np.array([float(v) for v in values.values()])
     columns = set_matrix(values.values(), n_sets)

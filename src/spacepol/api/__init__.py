@@ -12,7 +12,7 @@ The reasoning behind it, and what was measured: the internals page of the docume
 from __future__ import annotations
 
 from .inputs import parse_wavelengths, load, build_model, parse_observables, build_posterior, parameter_values
-from .inversion import invert, calibrate, optimize, compare
+from .inversion import invert, calibrate, optimize, compare, Comparison
 from .forward import forward, synth
 from .observing import Contrast, contrast, observe, frame, Sky, sky
 from .criticism import Diagnosis, diagnose, Ladder, ladder, Design, design
@@ -28,6 +28,7 @@ __all__ = [
     "calibrate",
     "optimize",
     "compare",
+    "Comparison",
     "forward",
     "synth",
     "Contrast",

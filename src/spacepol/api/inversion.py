@@ -1,9 +1,11 @@
-"""Posteriors from Python: ``invert`` (any registered sampler, its report and resumable chain in ``out``) and
-``calibrate`` (simulation-based calibration of an engine)."""
+"""Posteriors and engines from Python: ``invert`` (any registered sampler, its report and resumable chain in
+``out``), ``calibrate`` (simulation-based calibration of an engine), ``optimize`` (one engine's best fit) and
+``compare`` (several engines on one posterior)."""
 
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -153,10 +155,23 @@ def optimize(data, model="paper", method: str = "ga", prior=None, *, observables
                          seed=seed)
 
 
+@dataclass
+class Comparison:
+    """Several engines on one posterior: ``content`` (optimizers.json: per engine and seed the best objective, the
+    evaluations it took and the spread of the optima) and the folder its figures and report went to (``out``)."""
+
+    content: dict
+    out: Path
+
+    def to_json(self) -> dict:
+        """``optimizers.json``'s content."""
+        return self.content
+
+
 def compare(data, model="paper", methods=None, seeds: int = 3, out="reports/compare", prior=None, *,
-            observables=None, dispersion=None, seed: int = 0) -> Path:
+            observables=None, dispersion=None, seed: int = 0) -> Comparison:
     """Several engines (``methods``; default every optimizer and the samplers), ``seeds`` seeds each, on the same
-    posterior against its reference; figures and table in ``out`` (returned)."""
+    posterior against its reference; figures, table and report.html in ``out``."""
     from ..infer.engine_registry import check_method
     from ..io.output import check_output_dir
     from ..report.compare import run_comparison
@@ -166,5 +181,4 @@ def compare(data, model="paper", methods=None, seeds: int = 3, out="reports/comp
         check_method(method)
     data = load(data) if isinstance(data, (str, Path)) else data
     posterior = build_posterior(data, model, prior, observables, dispersion)
-    run_comparison(posterior, data, out, methods=methods, seeds=seeds, base_seed=seed)
-    return out
+    return Comparison(run_comparison(posterior, data, out, methods=methods, seeds=seeds, base_seed=seed), out)

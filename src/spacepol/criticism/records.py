@@ -94,8 +94,25 @@ _REFITTED_ONLY = ("delta_log_evidence", "delta_log_evidence_error", "explains_mi
 _WHERE_SET = ("tied_with", "dominated_by", "delta_to_leader", "delta_to_leader_se", "plugin_delta", "plugin_se")
 
 
+class _ReadsAsJSON(Mapping):
+    """Read access to a record through its JSON entry: ``record["change"]``, ``record.get("tied_with", [])``."""
+
+    def to_json(self) -> dict:
+        """The record as JSON."""
+        raise NotImplementedError
+
+    def __getitem__(self, key):
+        return self.to_json()[key]
+
+    def __iter__(self):
+        return iter(self.to_json())
+
+    def __len__(self):
+        return len(self.to_json())
+
+
 @dataclass(frozen=True, eq=False)
-class RankingEntry(Mapping):
+class RankingEntry(_ReadsAsJSON):
     """One change in a diagnosis's ranking, immutable: what it is (``effect``, ``change``), its differences to the
     model where refitted (ELPD-LOO with SE, ln Bayes factor with error), its screening gain, the explanation in
     words and its posterior's quality; for a change not refitted, why (``dominated_by`` the leader and the gap to
@@ -137,15 +154,6 @@ class RankingEntry(Mapping):
                 not in (None, ())}
         return out
 
-    def __getitem__(self, key):
-        return self.to_json()[key]
-
-    def __iter__(self):
-        return iter(self.to_json())
-
-    def __len__(self):
-        return len(self.to_json())
-
 
 @dataclass(eq=False)
 class DiagnosisRecord(_JSONView):
@@ -162,7 +170,7 @@ class DiagnosisRecord(_JSONView):
 
 
 @dataclass(frozen=True, eq=False)
-class RoundStep(Mapping):
+class RoundStep(_ReadsAsJSON):
     """One step of the path of ``diagnose --rounds``, immutable: the model after it and the ``change`` that made it
     (None for the start) with its delta ELPD-LOO and SE, the changes ``tied_with`` it and the ``alternatives``
     refitted beside it, the fit and the inferred against the measured noise, the residual structure and parameters at
@@ -197,15 +205,6 @@ class RoundStep(Mapping):
         if self.equivalent is not None:
             out |= {"equivalent": list(self.equivalent), "better": list(self.better or ())}
         return out
-
-    def __getitem__(self, key):
-        return self.to_json()[key]
-
-    def __iter__(self):
-        return iter(self.to_json())
-
-    def __len__(self):
-        return len(self.to_json())
 
 
 @dataclass(eq=False)

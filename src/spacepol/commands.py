@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
 from .errors import ParameterError
 from .io import Dataset, read_measurements, write_table
 from .io.output import check_output_dir, check_output_file

@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import ParameterError, UnknownNameError
 from ..infer.result import Result
 from ..physics.model import Model
-from .inputs import prior_overrides, build_model, build_posterior, load, parse_observables
+from .inputs import as_dataset, build_model, build_posterior, parse_observables, prior_overrides
 from .inversion import data_label
 
 
@@ -76,7 +76,7 @@ def diagnose(data, model="paper", *, rounds: int | None = None, candidates=None,
         raise UnknownNameError(f"--criterion {criterion}: unknown ({', '.join(CRITERIA)})")
     if not isinstance(workers, int) or workers < 1:
         raise ParameterError(f"--workers {workers}: need a whole number of at least 1")
-    data = load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data, wavelength_um, in_plane)
     full_model = build_model(model, data, dispersion)  # over several wavelengths: n, k per wavelength
     fitted = parse_observables(observables)
     rng = np.random.default_rng(seed)
@@ -135,7 +135,7 @@ def ladder(data, model="paper", changes=(), *, observables=None, dispersion=None
     current = build_model(model if isinstance(model, (str, Model)) else model.model)
     for step in steps:  # check the whole ladder composes before fitting anything
         current = parse(current, step).model
-    data = load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data, wavelength_um, in_plane)
     rungs = climb(data, build_model(model, data, dispersion), steps, seed=seed, observables=parse_observables(observables))
     if out is not None:
         from ..report.ladder_report import write_ladder_report
@@ -184,7 +184,7 @@ def design(data, model="paper", *, picks: int = 3, noise: dict | None = None, pr
                                  f"{', '.join(candidates)} and a finite X > 0")
     if picks < 1:
         raise ParameterError(f"--picks {picks}: need at least 1")
-    data = load(data) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data)
     post = build_posterior(data, model, prior, observables)
     if progress:
         print(f"design: the optimum of {post.likelihood.model.name} on {len(data)} geometries "

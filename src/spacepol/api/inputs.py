@@ -55,6 +55,11 @@ def load(path, wavelength_um=None, in_plane: bool = False) -> Dataset:
     return data.in_plane() if in_plane else data
 
 
+def as_dataset(data, wavelength_um=None, in_plane: bool = False) -> Dataset:
+    """``data`` as a Dataset: a Dataset as it is, a file path through ``load``."""
+    return load(data, wavelength_um, in_plane) if isinstance(data, (str, Path)) else data
+
+
 def build_model(spec, data: Dataset | None = None, dispersion: dict | str | None = None):
     """The model named by ``spec`` (an effect list such as ``"paper+lambertian"``, a preset, or a Model). Over the
     several wavelengths of ``data`` a SpectralModel: n, k per wavelength, or the ``dispersion`` law

@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..infer.result import Result
 from ..io.dataset import Dataset
-from .inputs import build_model, build_posterior, load, parse_observables
+from .inputs import as_dataset, build_model, build_posterior, parse_observables
 
 
 def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0, out=None, *,
@@ -38,7 +38,7 @@ def invert(data, model="paper", prior=None, engine: str = "emcee", seed: int = 0
                **({"max_steps": steps} if steps is not None else {}), **(engine_options or {})}
     sampler.check_options(options)
     parse_observables(observables)  # registers a user's observable file before its columns are read
-    data = load(data) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data)
     post = build_posterior(data, model, prior, observables, dispersion, robust)
     if walkers is not None:
         from ..infer.inversion import check_walkers
@@ -143,7 +143,7 @@ def optimize(data, model="paper", method: str = "ga", prior=None, *, observables
     from ..infer.prior_set import PriorSet
 
     check_method(method)
-    data = load(data) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data)
     posterior = build_posterior(data, model, prior, observables, dispersion)
     engine = engines.get(method)
     if engine.kind == SAMPLER:
@@ -179,6 +179,6 @@ def compare(data, model="paper", methods=None, seeds: int = 3, out="reports/comp
     out = check_output_dir(Path(out))
     for method in methods or []:
         check_method(method)
-    data = load(data) if isinstance(data, (str, Path)) else data
+    data = as_dataset(data)
     posterior = build_posterior(data, model, prior, observables, dispersion)
     return Comparison(run_comparison(posterior, data, out, methods=methods, seeds=seeds, base_seed=seed), out)

@@ -76,9 +76,9 @@ def structured(summary: RunSummary) -> bool:
     chi^2 > 1.5; with inferred noise that the data also measure themselves, an inferred level above 1.5x the
     measured one; with inferred noise alone chi^2 ~ 1 by construction and says nothing."""
     if summary.noise:  # the data measure their noise: explained only within 1.5x of it
-        return not explains(summary.noise) or summary.residual_structure["structured"]
+        return not explains(summary.noise) or summary.residuals_structured
     above_floor = not inferred_noise_levels(summary) and summary.fit["chi2_red"] > 1.5
-    return above_floor or summary.residual_structure["structured"]
+    return above_floor or summary.residuals_structured
 
 
 def conclusion(base, confirmed, verdict) -> str:
@@ -96,7 +96,7 @@ def conclusion(base, confirmed, verdict) -> str:
     text = f"{lead.label[0].upper()}{lead.label[1:]}: it is the change that improves ELPD-LOO most, by more than 2 SE."
     if structured(after):
         text += (f" It helps, but does not explain the misfit (partly explained): after it the residuals are still "
-                 f"structured ({describe_fit(after)}; " + " ".join(after.residual_structure["findings"])
+                 f"structured ({describe_fit(after)}; " + " ".join(after.residual_findings)
                  + "). Run diagnose again on the changed model (or use --rounds); if nothing else in the library helps, "
                  "the rest comes from an effect outside it.")
     else:
@@ -153,7 +153,7 @@ def explain_change(c, base) -> str:
     bounds = [bound_finding(f) for f in c.inversion.summary.at_bound]
     if c.significant and structured(c.inversion.summary):
         bounds.insert(0, "it helps, but does not explain the misfit: after it the residuals are still structured ("
-                      + " ".join(c.inversion.summary.residual_structure["findings"]) + ").")
+                      + " ".join(c.inversion.summary.residual_findings) + ").")
     return (f"{physics} Adding it changes ELPD-LOO by {c.delta_elpd:+.1f} +- {c.delta_elpd_se:.1f} ({verdict}); "
             f"{rmse}" + "; ".join(why) + "." + ("".join(f" Caution: {b}" for b in bounds)))
 

@@ -48,7 +48,7 @@ def climb(data, model: Model, additions: list[str], seed: int = 0, observables=N
                       "rhat_max": inv.summary.diagnostics["rhat_max"],
                       "pareto_k": inv.summary.diagnostics.get("pareto_k"), "parameters": inv.summary.parameters,
                       "at_bound": inv.summary.at_bound,
-                      "residual_structure": inv.summary.residual_structure["findings"]}, inv))
+                      "residual_structure": inv.summary.residual_findings}, inv))
     return rungs
 
 

@@ -12,18 +12,19 @@ import numpy as np
 
 
 class _JSONView(Mapping):
-    """Read access to a record's JSON content: ``record["verdict"]``, ``"ranking" in record``, ``record.get(...)``."""
+    """Read access to a record through its JSON: ``record["verdict"]``, ``"ranking" in record``, ``record.get(...)``.
+    ``to_json`` is ``content`` unless a record builds its JSON otherwise."""
 
     content: dict
 
     def __getitem__(self, key):
-        return self.content[key]
+        return self.to_json()[key]
 
     def __iter__(self):
-        return iter(self.content)
+        return iter(self.to_json())
 
     def __len__(self):
-        return len(self.content)
+        return len(self.to_json())
 
     def to_json(self) -> dict:
         """The record as JSON (what ``--json`` and the report files hold)."""
@@ -94,25 +95,8 @@ _REFITTED_ONLY = ("delta_log_evidence", "delta_log_evidence_error", "explains_mi
 _WHERE_SET = ("tied_with", "dominated_by", "delta_to_leader", "delta_to_leader_se", "plugin_delta", "plugin_se")
 
 
-class _ReadsAsJSON(Mapping):
-    """Read access to a record through its JSON entry: ``record["change"]``, ``record.get("tied_with", [])``."""
-
-    def to_json(self) -> dict:
-        """The record as JSON."""
-        raise NotImplementedError
-
-    def __getitem__(self, key):
-        return self.to_json()[key]
-
-    def __iter__(self):
-        return iter(self.to_json())
-
-    def __len__(self):
-        return len(self.to_json())
-
-
 @dataclass(frozen=True, eq=False)
-class RankingEntry(_ReadsAsJSON):
+class RankingEntry(_JSONView):
     """One change in a diagnosis's ranking, immutable: what it is (``effect``, ``change``), its differences to the
     model where refitted (ELPD-LOO with SE, ln Bayes factor with error), its screening gain, the explanation in
     words and its posterior's quality; for a change not refitted, why (``dominated_by`` the leader and the gap to
@@ -170,7 +154,7 @@ class DiagnosisRecord(_JSONView):
 
 
 @dataclass(frozen=True, eq=False)
-class RoundStep(_ReadsAsJSON):
+class RoundStep(_JSONView):
     """One step of the path of ``diagnose --rounds``, immutable: the model after it and the ``change`` that made it
     (None for the start) with its delta ELPD-LOO and SE, the changes ``tied_with`` it and the ``alternatives``
     refitted beside it, the fit and the inferred against the measured noise, the residual structure and parameters at

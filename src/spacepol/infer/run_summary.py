@@ -68,7 +68,7 @@ class RunSummary:
         return list(self.residual_structure.get("findings", []))
 
     @property
-    def structured(self) -> bool:
+    def residuals_structured(self) -> bool:
         """Whether the residuals are structured (runs or lag-1 correlation beyond chance)."""
         return bool(self.residual_structure.get("structured", False))
 

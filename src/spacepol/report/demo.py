@@ -190,7 +190,7 @@ def _demo_sections(out: Path, forward_lines, summary, hidden_path, hidden, truth
             [f"n = {n['median']:.3f}, 90 % interval [{n['q05']:.3f}, {n['q95']:.3f}]; R-hat max {d['rhat_max']:.4f}, "
              f"ESS min {d['ess_min']:.0f}; inferred noise: {_noise_words(summary)} (with inferred noise, reduced "
              f"chi^2 is ~1 by construction)."]
-            + [summary.references["n"]["explanation"]] + summary.residual_structure["findings"]
+            + [summary.references["n"]["explanation"]] + summary.residual_findings
             + summary.identifiability["findings"])
          + '<p><a href="ptfe_paper/report.html">Full report of the inversion</a></p>'
          + H.image(H.png_file_to_data_uri(out / "ptfe_paper" / "residuals.png"),

@@ -125,7 +125,7 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
                         [[_fmt(fit["rmse_dop"]), f"{fit['chi2_red']:.3f}", f"{fit['elpd_loo']:.2f}", f"{fit['elpd_loo_se']:.2f}"]])
          + (H.paragraph("PSIS-LOO Pareto k > 0.7 (LOO unreliable there, the fit is sensitive to these points): "
                         + ", ".join(s.pareto_k_bad)) if s.pareto_k_bad else "")
-         + H.bullets(s.residual_structure["findings"])
+         + H.bullets(s.residual_findings)
          + (H.paragraph("Noise the data measure themselves (reciprocal pairs, repeated geometries) against the noise the "
                         "fit inferred; a model explains the data only where the ratio is at most "
                         f"{EXPLAINED_NOISE_RATIO:g}:") + H.bullets(noise_findings(s.noise)) if s.noise else "")

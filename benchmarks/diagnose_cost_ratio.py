@@ -3,7 +3,10 @@
 
 Goal: both ratios <= 4, and the PTFE diagnosis <= 120 s on 2 cores.
 
-    python benchmarks/diagnose_cost_ratio.py [--sets ptfe,hidden] [--rounds 4] [--seed 0]
+    python benchmarks/diagnose_cost_ratio.py [--sets ptfe,hidden] [--rounds 4] [--seed 0] [--profile]
+
+``--profile``: the diagnosis under cProfile, its time split by phase (the cumulative time of the functions that do
+each: ``PHASES``; they nest, so the phases overlap where one calls another, e.g. compilation inside screening).
 
 The sets: (a) NIST's PTFE at 0.633 um, the plane of incidence, full Mueller matrix and BRDF; (b) the bundled 84-point
 DOP + BRDF set with a hidden effect. For each: the wall time of `invert` (emcee to convergence, the default of
@@ -15,7 +18,9 @@ average before and after. The run goes first, so that it pays the compilations i
 from __future__ import annotations
 
 import argparse
+import cProfile
 import os
+import pstats
 import platform
 import time
 
@@ -23,6 +28,28 @@ import numpy as np
 
 import spacepol
 from spacepol.paths import bundled
+
+
+# phase: (module path suffix, function name) whose cumulative time is the phase's
+PHASES = {
+    "compilation (JAX tracing and XLA)": [("jax/_src/pjit.py", "cache_miss")],
+    "screening (each change near the base's optimum)": [("criticism/candidate_fits.py", "_screen")],
+    "leaders' global multistart": [("criticism/candidate_fits.py", "_leader")],
+    "refits (posteriors for ELPD-LOO)": [("criticism/candidate_fits.py", "fit_for_elpd")],
+    "PSIS-LOO": [("infer/diagnostics.py", "loo"), ("infer/laplace.py", "importance_loo")],
+    "likelihood calls (all phases)": [("infer/likelihood.py", "_call")],
+}
+
+
+def phase_table(profile: cProfile.Profile) -> list[tuple[str, float]]:
+    """(phase, cumulative s) of ``PHASES`` in ``profile``; a phase's functions are summed (they do not nest)."""
+    stats = pstats.Stats(profile).stats  # {(file, line, name): (cc, nc, tt, ct, callers)}
+    out = []
+    for phase, functions in PHASES.items():
+        total = sum(ct for (file, _, name), (_, _, _, ct, _) in stats.items()
+                    if any(file.endswith(suffix) and name == fn for suffix, fn in functions))
+        out.append((phase, total))
+    return out
 
 
 def sets() -> dict:
@@ -36,6 +63,7 @@ def main() -> None:
     ap.add_argument("--sets", default="ptfe,hidden")
     ap.add_argument("--rounds", type=int, default=4)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--profile", action="store_true", help="split the diagnosis's time by phase (cProfile)")
     args = ap.parse_args()
     spacepol.configure_process(small_calls=True)  # as the command line runs
     load = os.getloadavg()
@@ -45,8 +73,13 @@ def main() -> None:
         start = time.perf_counter()
         run = spacepol.invert(data, "paper", seed=args.seed, progress=False)
         run_s = time.perf_counter() - start
+        profile = cProfile.Profile() if args.profile else None
         start = time.perf_counter()
+        if profile:
+            profile.enable()
         found = spacepol.diagnose(data, "paper", rounds=args.rounds, seed=args.seed)
+        if profile:
+            profile.disable()
         diagnose_s = time.perf_counter() - start
         first = found.content.get("seconds") or found.content["rounds"][0].get("seconds", {})
         path = " -> ".join(r["change"] or r["model"] for r in found.content.get("rounds", []))
@@ -54,6 +87,9 @@ def main() -> None:
               f"--rounds {args.rounds} {diagnose_s:.1f} s (round 1: base fit {first.get('base_fit', np.nan):.0f} s, "
               f"screening {first.get('screening', np.nan):.0f} s, confirmation {first.get('confirmation', np.nan):.0f} s); "
               f"path {path}; ratio {diagnose_s / run_s:.2f} (goal <= 4)", flush=True)
+        if profile:
+            for phase, seconds in phase_table(profile):
+                print(f"  {phase:<50s} {seconds:8.1f} s ({100 * seconds / diagnose_s:4.0f} %)")
     print(f"load average before/after {load[0]:.2f}/{os.getloadavg()[0]:.2f}")
 
 

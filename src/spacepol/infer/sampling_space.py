@@ -16,6 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._runtime import ensure_double_precision
+from ..priors import Uniform
 from .prior_set import PriorSet
 
 _U_FLOOR = 1e-15  # a parameter exactly at a bound maps to a finite z (|z| <= 34.5)
@@ -57,6 +58,10 @@ class SamplingSpace:
         self.declared = [n for n in self.names if n in set(declared)]
         self._logit = np.array([n not in set(declared) for n in self.names])
         self._priors = [priors.priors[n] for n in self.names]
+        # the logit columns under a Uniform prior, rescaled in one array operation (emcee calls to_theta every step)
+        self._uniform = np.array([self._logit[j] and type(p) is Uniform for j, p in enumerate(self._priors)], bool)
+        self._lower = np.array([p.lower if u else 0.0 for p, u in zip(self._priors, self._uniform)])
+        self._width = np.array([p.upper - p.lower if u else 0.0 for p, u in zip(self._priors, self._uniform)])
 
     @property
     def name(self) -> str:
@@ -92,19 +97,28 @@ class SamplingSpace:
         z = np.atleast_2d(np.asarray(z, float))
         flat = z.reshape(-1, z.shape[-1])
         u = 0.5 * (1.0 + np.tanh(0.5 * flat))  # sigmoid without overflow
-        theta = np.column_stack([p.rescale(u[:, j]) if self._logit[j] else flat[:, j] for j, p in enumerate(self._priors)])
+        theta = np.where(self._uniform, self._lower + self._width * u, flat)
+        for j, p in enumerate(self._priors):
+            if self._logit[j] and not self._uniform[j]:
+                theta[:, j] = p.rescale(u[:, j])
         return theta.reshape(z.shape)
 
     def ln_prior(self, z):
         """The declared priors' log density in z (rows over the last axis): log sigmoid(z) + log sigmoid(-z) for
         a logit coordinate, the prior's own ln_prob (-inf outside its support) for a declared one."""
-        xp = jnp if isinstance(z, jax.Array) else np
+        if not isinstance(z, jax.Array):  # numpy: the logit columns at once
+            z = np.asarray(z, float)
+            a = np.abs(z[..., self._logit])
+            total = -(a + 2.0 * np.log1p(np.exp(-a))).sum(axis=-1)
+            for j in np.flatnonzero(~self._logit):
+                total = total + self._priors[j].ln_prob(z[..., j])
+            return total
         total = 0.0
         for j, prior in enumerate(self._priors):
             zj = z[..., j]
             if self._logit[j]:
-                a = xp.abs(zj)
-                total = total - (a + 2.0 * xp.log1p(xp.exp(-a)))
+                a = jnp.abs(zj)
+                total = total - (a + 2.0 * jnp.log1p(jnp.exp(-a)))
             else:
                 total = total + prior.ln_prob(zj)
         return total

@@ -19,18 +19,15 @@ class DESnookerMove(emcee.moves.DESnookerMove):
 
     def get_proposal(self, s, c, random):
         """emcee's move interface: proposals for the walkers ``s`` from the complementary ensemble ``c``, with their
-        log Metropolis factors."""
+        log Metropolis factors. For each walker one member of each of the three other subsets, in random order (z, z1,
+        z2); all walkers at once (a loop over walkers cost more than the likelihood of a small problem)."""
         count, ndim = s.shape
-        sizes = list(map(len, c))
-        q = np.empty_like(s)
-        metropolis = np.empty(count, dtype=np.float64)
-        for i in range(count):
-            w = np.array([c[j][random.randint(sizes[j])] for j in range(3)])
-            random.shuffle(w)
-            z, z1, z2 = w
-            delta = s[i] - z
-            norm = np.linalg.norm(delta)
-            u = delta / norm
-            q[i] = s[i] + u * self.gammas * (np.dot(u, z1) - np.dot(u, z2))
-            metropolis[i] = np.log(np.linalg.norm(q[i] - z)) - np.log(norm)
+        picked = np.stack([c[j][random.randint(len(c[j]), size=count)] for j in range(3)], axis=1)  # (count, 3, D)
+        order = np.argsort(random.random_sample((count, 3)), axis=1)  # a uniform random permutation per walker
+        z, z1, z2 = np.moveaxis(picked[np.arange(count)[:, None], order], 1, 0)
+        delta = s - z
+        norm = np.linalg.norm(delta, axis=1)
+        u = delta / norm[:, None]
+        q = s + u * (self.gammas * (np.einsum("ij,ij->i", u, z1) - np.einsum("ij,ij->i", u, z2)))[:, None]
+        metropolis = np.log(np.linalg.norm(q - z, axis=1)) - np.log(norm)
         return q, (ndim - 1.0) * metropolis

@@ -118,6 +118,7 @@ class Likelihood:
         self._jitted, self._program = {}, None  # compiled at the first call, per kind and parameter layout
         # batch sizes a caller will use again and again (emcee's half-ensemble): compiled exactly, not padded
         self.exact_sizes: set[int] = set()
+        self._sizes_for, self._sizes = None, []  # ``_compiled_sizes``'s last answer and the exact sizes it was for
 
     @property
     def numbers_per_set(self) -> int:
@@ -223,8 +224,7 @@ class Likelihood:
                 v = np.asarray(v, float).reshape(-1)
                 columns.append((name, v))
                 n_sets = max(n_sets, v.size)
-        sizes = sorted({size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
-                        and (size == _BATCH_SIZES[0] or not self.compiles_one_block)} | self.exact_sizes)
+        sizes = self._compiled_sizes()
         rows = _block_rows(n_sets, sizes)
         # ``total`` of a large likelihood: the pointwise program, summed (see ``total``)
         summed = which == 1 and self.compiles_one_block and rows * self.numbers_per_set <= _POINTWISE_NUMBERS
@@ -246,6 +246,16 @@ class Likelihood:
             out.append(np.asarray(self._jitted[key](block))[:n])
         out = out[0] if len(out) == 1 else np.concatenate(out, axis=0)
         return out.sum(axis=-1) if summed else out
+
+    def _compiled_sizes(self) -> list[int]:
+        """The block sizes calls are padded to: the fixed ones this likelihood compiles and the callers' exact sizes
+        (kept until those change: a sampler calls this at every step)."""
+        exact = frozenset(self.exact_sizes)
+        if self._sizes_for != exact:
+            fixed = {size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
+                     and (size == _BATCH_SIZES[0] or not self.compiles_one_block)}
+            self._sizes_for, self._sizes = exact, sorted(fixed | exact)
+        return self._sizes
 
     def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
         return jax.jit(self.function(which, names, scalars, levels))

@@ -30,7 +30,7 @@ from ptfe_models import load, model_for  # noqa: E402
 
 from spacepol import configure_process  # noqa: E402
 from spacepol.infer.engines.emcee_sampler import ball, default_walkers, sample_emcee  # noqa: E402
-from spacepol.infer.laplace import _hessian, _polish_mode  # noqa: E402
+from spacepol.infer.laplace import mode_and_precision  # noqa: E402
 from spacepol.infer.optimum import find_optimum_on_every  # noqa: E402
 from spacepol.infer.posterior import Posterior  # noqa: E402
 from spacepol.infer.sampling_space import SamplingSpace  # noqa: E402
@@ -64,11 +64,7 @@ def laplace_start(post: Posterior, centre, walkers: int, rng) -> np.ndarray:
     """Walkers drawn from N(mode, cov / 4) in the logit space: cov the inverse Hessian at the polished mode, its
     eigenvalues floored at 1 (flat and negative directions get unit width)."""
     space = SamplingSpace(post.priors)
-    log_prob_z = space.log_prob(post)
-    mode = _polish_mode(log_prob_z, space.to_z(np.asarray(centre, float)[None])[0])
-    curvature = -_hessian(log_prob_z, mode, np.full(mode.size, 1e-2)).diagonal()
-    scale = np.where(np.isfinite(curvature) & (curvature > 0), 1 / np.sqrt(np.abs(curvature) + 1e-300), 1.0)
-    precision = -_hessian(log_prob_z, mode, np.clip(0.5 * scale, 1e-5, 1.0))
+    mode, precision = mode_and_precision(space.log_prob(post), space.to_z(np.asarray(centre, float)[None])[0])
     values, vectors = np.linalg.eigh(0.5 * (precision + precision.T))
     print(f"  Hessian eigenvalues: {np.sum(values <= 0)} <= 0, smallest {values[:3].round(2)}, largest "
           f"{values[-1]:.3g}", flush=True)

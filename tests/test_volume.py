@@ -138,3 +138,18 @@ def test_volume_polarizes_where_multiple_scattering_does_not():
     sub = Model.from_string("specular+subsurface").evaluate({**base, "rho_s": 1.0}, Geometry(ti, tr, 180.0 - ps)).stokes
     assert abs(sub[2, 0] / sub[0, 0]) < 1e-12
     assert abs(vol[2, 0] / vol[0, 0]) > 0.05
+
+
+@pytest.mark.parametrize("effect", ["volume", "volume_rayleigh", "phase_matrix"])
+def test_the_stokes_vector_is_the_mueller_matrix_first_column(effect):
+    """The Stokes-only program (DOP and BRDF data) builds its four elements apart from the Mueller matrix's sixteen,
+    which the comparison with SCATMECH checks: the two must agree for random parameter sets of the prior."""
+    model = Model.from_string(f"specular+{effect}")
+    rng = np.random.default_rng(5)
+    params = {p.name: rng.uniform(*p.prior.bounds, 8) for p in model.parameters}
+    ti, tr, ps = _corpus(120)
+    geometry = Geometry(ti, tr, 180.0 - ps)
+    stokes = model.evaluate(params, geometry).stokes
+    mueller = model.evaluate(params, geometry, mueller=True).mueller
+    assert np.all(np.isfinite(stokes)) and np.all(stokes[0] > 0)
+    np.testing.assert_allclose(stokes, mueller[:, 0], rtol=1e-12, atol=1e-14 * float(np.max(stokes[0])))

@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -48,7 +49,7 @@ from spacepol.observables.mueller import GROUP_OF  # noqa: E402
 from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
 from spacepol.physics.spectral import SpectralModel, wavelength_label  # noqa: E402
-from spacepol.priors import Uniform  # noqa: E402
+from spacepol.priors import Fixed, Uniform  # noqa: E402
 
 MODELS = ("paper,specular+smith+subsurface+volume,specular+smith+subsurface+phase_matrix,"
           "specular+smith+subsurface+phase_matrix+polarization_memory")
@@ -89,19 +90,45 @@ def anisotropy(data, noise: dict) -> dict:
 PHYSICAL = " [physical]"  # a model entry ending so: every index-like parameter's prior held to PTFE_BAND
 
 
+def entry_parts(entry: str) -> tuple[str, bool, dict]:
+    """(model string, whether the indices are held physical, {parameter: fixed value}) of a ``--models`` entry:
+    the model, then optionally one bracket of options separated by spaces, ``physical`` and ``NAME=VALUE`` (that
+    parameter held at that value: e.g. ``[w_pm=1 dl_pm=0]``, a sub-model whose parameters at a bound are fixed
+    there, for ELPD-LOO to weigh against the free one)."""
+    spec, _, options = entry.partition(" [")
+    physical, fixed = False, {}
+    for token in options.removesuffix("]").split():
+        name, equals, value = token.partition("=")
+        if token == "physical":
+            physical = True
+        elif not equals:
+            raise SpacepolError(f"model entry '{entry}': option '{token}' is neither 'physical' nor NAME=VALUE")
+        else:
+            try:
+                fixed[name] = float(value)
+            except ValueError:
+                raise SpacepolError(f"model entry '{entry}': '{token}' is not NAME=<number>") from None
+    return spec, physical, fixed
+
+
 def model_for(data, spec: str):
     """The model an entry of ``--models`` names, one index per wavelength where ``data`` hold several."""
     lams = np.unique(data.wavelength_um)
-    model = Model.from_string(spec.removesuffix(PHYSICAL))
+    model = Model.from_string(entry_parts(spec)[0])
     return SpectralModel(model, lams) if len(lams) > 1 else model
 
 
-def index_priors(model, spec: str) -> dict:
-    """For an entry ending in ``PHYSICAL``: {every index-like parameter: Uniform over PTFE_BAND}, so that the fit says
-    what holding the indices physical costs; else nothing."""
-    if not spec.endswith(PHYSICAL):
-        return {}
-    return {p.name: Uniform(*PTFE_BAND) for p in model.parameters if p.name.split("@")[0] in INDEX_LIKE}
+def entry_priors(model, spec: str) -> dict:
+    """The prior overrides an entry asks for: with ``physical`` every index-like parameter Uniform over PTFE_BAND, so
+    that the fit says what holding the indices physical costs; each NAME=VALUE a Fixed prior (a name the model does
+    not have is an error)."""
+    _, physical, fixed = entry_parts(spec)
+    names = [p.name for p in model.parameters]
+    unknown = sorted(set(fixed) - set(names))
+    if unknown:
+        raise SpacepolError(f"model entry '{spec}': no parameter {', '.join(unknown)} in {model.name}")
+    out = {p.name: Uniform(*PTFE_BAND) for p in model.parameters if physical and p.name.split("@")[0] in INDEX_LIKE}
+    return out | {name: Fixed(value) for name, value in fixed.items()}
 
 
 def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
@@ -111,7 +138,7 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
     (``optimum.find_optimum_on_every``)."""
     start = time.perf_counter()
     model = model_for(data, spec)
-    post = Posterior.build(data, model, prior_overrides=index_priors(model, spec) or None)
+    post = Posterior.build(data, model, prior_overrides=entry_priors(model, spec) or None)
     best, centre = find_optimum_on_every(post, search_every, np.random.default_rng(seed), evaluations=3000)
     found = time.perf_counter() - start
     print(f"  {spec}: maximum {best:.1f} in {found:.0f} s; posterior by {method}", flush=True)
@@ -320,7 +347,8 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
 
 def pointwise_file(out: Path, spec: str) -> Path:
     """Where a model's pointwise ELPD-LOO is kept (the ranking's paired differences need it)."""
-    return out / "pointwise" / f"{spec.replace(PHYSICAL, '_physical').replace('+', '_')}.npy"
+    name = spec.replace(PHYSICAL, "_physical").replace("+", "_")
+    return out / "pointwise" / f"{re.sub(r'[^A-Za-z0-9_.-]', '_', name)}.npy"
 
 
 def finished(out: Path, settings: dict) -> tuple[dict, dict | None, str | None]:
@@ -349,15 +377,15 @@ def main(argv=None) -> int:
                         "every n-th row only, then polished on all rows (8 for the whole file at four wavelengths)")
     parser.add_argument("--out", default="reports/ptfe_models")
     args = parser.parse_args(argv)
-    try:  # every model named, before any work
+    data = load(args.wavelength_um)
+    try:  # every model named, with its options, before any work
         for spec in args.models.split(","):
-            Model.from_string(spec.removesuffix(PHYSICAL))
+            entry_priors(model_for(data, spec), spec)
     except SpacepolError as error:
         print(f"ptfe_models: --models: {error}", file=sys.stderr)
         return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    data = load(args.wavelength_um)
     noise = measured_noise(data)  # from every row: the plane of incidence alone holds no reciprocal pair
     aniso = anisotropy(data, noise)
     masked = 0

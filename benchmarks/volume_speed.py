@@ -2,7 +2,7 @@
 NIST SCATMECH's First_Diffuse_BRDF_Model (pySCATMECH, C++ called once per geometry from Python: the independent
 implementation the tests compare with) and against `subsurface`, the other lobe under the same interface.
 
-Cases: the full Mueller matrix of `specular+volume`, `specular+phase_matrix` (one draw from its prior) and
+Cases: the full Mueller matrix (and the Stokes vector alone, for DOP and BRDF data) of `specular+volume`, `specular+phase_matrix` (one draw from its prior) and
 `specular+subsurface` for 64 parameter sets x 600 geometries
 (random over the hemisphere, a third in the plane), and SCATMECH's matrix at one parameter set over the same
 geometries. Evaluations per second (sets x geometries), medians of repeats, the load average, and the largest
@@ -66,6 +66,9 @@ def main() -> None:
         seconds = _median_seconds(lambda: model.evaluate(params, geometry, mueller=True), 20)
         rates[spec] = SETS * geometry.size / seconds
         print(f"  {spec:22s} full Mueller {seconds * 1e3:8.2f} ms per call, {rates[spec] / 1e6:7.2f} M evaluations/s")
+        seconds = _median_seconds(lambda: model.evaluate(params, geometry), 20)  # what DOP and BRDF data need
+        print(f"  {spec:22s} Stokes only  {seconds * 1e3:8.2f} ms per call, "
+              f"{SETS * geometry.size / seconds / 1e6:7.2f} M evaluations/s")
     peer = BRDF_Model("First_Diffuse_BRDF_Model", {
         "lambda": 0.633, "substrate": f"({c['n']},{c['k']})", "type": 0, "phase_function": "CodeWhitney_Phase_Function",
         "phase_function.phase_function": "Henyey_Greenstein_Phase_Function", "phase_function.phase_function.g": c["g"],

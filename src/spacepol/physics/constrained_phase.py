@@ -159,12 +159,11 @@ def nodes_gauge(nodes: NodeValues):
 
 
 def spline_gauge(nodes: NodeValues):
-    """The largest gauge over the spline's Bezier control points: <= 1 means realizable at every angle."""
-    values = []
-    for row in CONTROL_POINTS:
-        point = [sum(float(w) * y for w, y in zip(row, e) if abs(w) > 1e-13) for e in nodes.elements()]
-        values.append(gauge(*point))
-    return reduce(jnp.maximum, values)
+    """The largest gauge over the spline's Bezier control points: <= 1 means realizable at every angle. All control
+    points at once, as one (points x nodes) product per element (a loop over them traced ~2,500 operations)."""
+    points = [jnp.tensordot(CONTROL_POINTS, jnp.stack(jnp.broadcast_arrays(*values)), axes=1)
+              for values in nodes.elements()]
+    return jnp.max(gauge(*points), axis=0)
 
 
 

@@ -36,7 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from spacepol.criticism.reciprocity import mirror_asymmetry  # noqa: E402
+from spacepol.criticism.reciprocity import mirror_asymmetry, mirror_scatter  # noqa: E402
 from spacepol.errors import SpacepolError  # noqa: E402
 from spacepol.infer.indices import INDEX_LIKE, index_findings  # noqa: E402
 from spacepol.infer.inference_data import median_fit  # noqa: E402
@@ -87,6 +87,30 @@ def anisotropy(data, noise: dict) -> dict:
     return out
 
 
+def exit_scatter(data) -> dict:
+    """{wavelength label: MirrorScatter}: the measurement's own spread per element group and exit-angle bin, from its
+    mirror pairs (``reciprocity.mirror_scatter``); the reciprocal pairs, which give the noise the likelihood is
+    compared with, lie at theta 30 and 45 deg only."""
+    return {wavelength_label(w): mirror_scatter(data.at_wavelength(float(w))) for w in np.unique(data.wavelength_um)}
+
+
+def exit_ratios(z: dict, data, noise: dict, scatter: dict) -> dict:
+    """{wavelength: {group: [RMS residual / the mirror pairs' spread, per exit-angle bin]}}: ``z`` (residuals over the
+    reciprocal pairs' noise, ``standardised``) back in the elements' units, against the spread the measurement shows
+    at those exit angles itself. 1 where the model leaves only what the data scatter by."""
+    out = {}
+    for w in np.unique(data.wavelength_um):
+        label = wavelength_label(w)
+        at = data.wavelength_um == w
+        bins = scatter[label].bin_of(np.asarray(data.theta_r, float)[at])
+        out[label] = {}
+        for g in ("pol", "lin", "circ"):
+            residual = np.stack([z[ch][at] for ch in z if GROUP_OF[ch] == g]) * noise[label][g]
+            out[label][g] = [float(np.sqrt(np.nanmean(residual[:, bins == b] ** 2)) / scatter[label].sd[g][b])
+                             if np.any(bins == b) else float("nan") for b in range(len(scatter[label].sd[g]))]
+    return out
+
+
 PHYSICAL = " [physical]"  # a model entry ending so: every index-like parameter's prior held to PTFE_BAND
 
 
@@ -131,7 +155,7 @@ def entry_priors(model, spec: str) -> dict:
     return out | {name: Fixed(value) for name, value in fixed.items()}
 
 
-def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
+def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict, scatter: dict,
         search_every: int = 1) -> tuple[dict, object, dict]:
     """(record, Result, standardised residuals) of ``spec`` on ``data``: maximum, posterior, ELPD-LOO, misfit per
     group, indices. ``search_every``: the global search on every n-th row, its optimum polished on all
@@ -155,6 +179,7 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict,
         "elpd_loo": s.fit["elpd_loo"], "elpd_loo_se": s.fit["elpd_loo_se"],
         "inferred_noise": {k: v["median"] for k, v in s.parameters.items() if k.startswith("sigma_m_")},
         "misfit_ratio": group_ratios(z, data),
+        "misfit_by_exit": exit_ratios(z, data, noise, scatter),
         "indices": [{"name": f.name, "median": f.median, "q05": f.q05, "q95": f.q95, "determined": f.determined,
                      "physical": f.physical, "text": f.text} for f in index_findings(parameters, PTFE_BAND)],
         "at_bound": [f"{b['parameter']} at its {b['side']} bound {b['bound']:g}" for b in s.at_bound],
@@ -313,7 +338,31 @@ def posterior_words(record: dict) -> str:
     return f"emcee, NOT converged (R-hat {record['rhat_max']:.2f}): its ELPD-LOO is not to be trusted"
 
 
-def write_report(out: Path, args, data, noise, aniso, masked: int, records, table, misfit) -> None:
+def exit_lines(scatter: dict, noise: dict, records: list[dict]) -> list[str]:
+    """The report's section on the measurement's spread by exit angle, and the best model's misfit against it."""
+    labels = next(iter(scatter.values())).labels()
+    lines = ["", "## The measurement's own spread by exit angle (mirror pairs)", "",
+             "The reciprocal pairs lie at theta 30 and 45 deg only. The mirror pairs (dphi, -dphi) cover every exit "
+             "angle: the robust SD of one normalised element from their differences, an upper bound of the noise "
+             "(anisotropy adds to it), against the reciprocal pairs' noise:", "",
+             "| wavelength | group | reciprocal pairs | " + " | ".join(labels) + " |", "|---|---|---|" + "---|" * len(labels)]
+    for w, sc in scatter.items():
+        for g in ("pol", "lin", "circ"):
+            lines.append(f"| {w} | {g} | {noise.get(w, {}).get(g, float('nan')):.4f} | "
+                         + " | ".join(f"{v:.4f}" for v in sc.sd[g]) + " |")
+    fitted = [r for r in records if "misfit_by_exit" in r]
+    if fitted:
+        best = max(fitted, key=lambda r: r["elpd_loo"])
+        lines += ["", f"{best['model']}'s RMS residual over that spread, per exit-angle bin (1: the model leaves what "
+                  f"the data scatter by; goal <= {GOAL_RATIO}):", "",
+                  "| wavelength | group | " + " | ".join(labels) + " |", "|---|---|" + "---|" * len(labels)]
+        for w, groups in best["misfit_by_exit"].items():
+            for g, values in groups.items():
+                lines.append(f"| {w} | {g} | " + " | ".join(f"{v:.2f}" for v in values) + " |")
+    return lines
+
+
+def write_report(out: Path, args, data, noise, scatter, aniso, masked: int, records, table, misfit) -> None:
     lines = [f"# PTFE under competing models ({', '.join(sorted(noise))} um jointly)", "",
              f"Re-made by `python studies/ptfe_models.py {' '.join(sys.argv[1:])}`; {len(data)} geometries"
              + (f" after {masked} anisotropic rows left out" if masked else "") + ".", "", "## Findings", ""]
@@ -323,6 +372,7 @@ def write_report(out: Path, args, data, noise, aniso, masked: int, records, tabl
     lines += ["", "## The noise the data measure (reciprocal pairs)", "", "| wavelength | pol | lin | circ |", "|---|---|---|---|"]
     lines += [f"| {w} | " + " | ".join(f"{v.get(g, float('nan')):.4f}" for g in ("pol", "lin", "circ")) + " |"
               for w, v in noise.items()]
+    lines += exit_lines(scatter, noise, records)
     lines += ["", "## Anisotropy, from the data alone", ""]
     lines += [f"- {w} um: {a.text}" for w, (a, _) in aniso.items()]
     lines += ["", ("The rows of the flagged pairs are left out of the fits (`--mask-anisotropic`)." if masked else
@@ -388,6 +438,7 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     noise = measured_noise(data)  # from every row: the plane of incidence alone holds no reciprocal pair
     aniso = anisotropy(data, noise)
+    scatter = exit_scatter(data)  # from every row, before any is left out: a mirror pair needs both members
     masked = 0
     if args.mask_anisotropic:
         drop = np.unique(np.concatenate([rows for _, rows in aniso.values()] or [np.empty(0, int)]))
@@ -406,7 +457,8 @@ def main(argv=None) -> int:
             pointwise[spec] = np.load(pointwise_file(out, spec))
             print(f"  {spec}: kept from {out / 'study.json'} (ELPD-LOO {record['elpd_loo']:.1f})", flush=True)
         else:
-            record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise, args.search_every)
+            record, inv, standard = fit(data, spec, args.seed, args.posterior, args.max_steps, noise, scatter,
+                                        args.search_every)
             pointwise[spec] = np.asarray(inv.loo["pointwise"])
             pointwise_file(out, spec).parent.mkdir(exist_ok=True)
             np.save(pointwise_file(out, spec), pointwise[spec])
@@ -420,10 +472,13 @@ def main(argv=None) -> int:
             misfit = None  # the best model was kept from an earlier run that did not map its misfit
         write_json(out / "study.json", {"settings": settings, "records": records, "ranking": table,
                                         "measured_noise": noise,
+                                        "mirror_spread": {w: {"edges_deg": sc.edges_deg, **{g: sc.sd[g].tolist()
+                                                                                             for g in sc.sd}}
+                                                          for w, sc in scatter.items()},
                                         "anisotropy": {w: {"pairs": len(a.pairs), "flagged": int(a.flagged.sum()),
                                                            "chi2_per_dof": a.excess} for w, (a, _) in aniso.items()},
                                         "masked_rows": masked, "misfit": misfit, "misfit_model": misfit_model})
-        write_report(out, args, data, noise, aniso, masked, records, table, misfit)
+        write_report(out, args, data, noise, scatter, aniso, masked, records, table, misfit)
         print(f"  {spec}: ELPD-LOO {record['elpd_loo']:.1f} +- {record['elpd_loo_se']:.1f} ({record['engine']}, "
               f"{record['seconds']:.0f} s)", flush=True)
     return 0

@@ -142,3 +142,37 @@ def test_mirror_asymmetry_is_noise_on_an_isotropic_set_and_flags_the_pairs_made_
     assert len(anisotropic.rows) == 20 and anisotropic.excess > clean.excess
     with pytest.raises(ValueError, match="no noise for the circ group"):
         reciprocity.mirror_asymmetry(data, {"pol": sigma, "lin": sigma})
+
+
+def test_mirror_scatter_follows_a_noise_that_grows_with_the_exit_angle():
+    """An isotropic set whose noise is 0.005 below 40 deg of exit and 0.015 above: the mirror pairs' scatter per exit
+    bin gives each bin's noise back within 20 % (each bin holds >= 300 differences: the MAD's relative SE ~ 1.17 /
+    sqrt(n) <= 6.8 %, so 20 % is 3 SE). Control: the same noise everywhere gives equal bins, and pairs made anisotropic raise the
+    scatter of their bin only."""
+    rng = np.random.default_rng(3)
+    data = _symmetric_set(0.0)
+    m, tr = data.mueller, np.abs(data.theta_r)
+    sigma = np.where(tr < 40, 0.005, 0.015)
+    noisy = m.copy()
+    noisy[1:] += sigma * rng.standard_normal(m[1:].shape)
+    noisy[0, 1:] += sigma * rng.standard_normal(m[0, 1:].shape)
+    scatter = reciprocity.mirror_scatter(Dataset(data.theta_i, data.theta_r, data.dphi, mueller=noisy,
+                                                 brdf=np.ones_like(tr)), edges_deg=(0, 40, 90))
+    for group in ("pol", "lin", "circ"):
+        assert np.all(scatter.count[group] >= 300), scatter.count[group]
+        np.testing.assert_allclose(scatter.sd[group], [0.005, 0.015], rtol=0.2, err_msg=group)
+    flat = reciprocity.mirror_scatter(_symmetric_set(0.01), edges_deg=(0, 40, 90))
+    for group in ("pol", "lin", "circ"):
+        np.testing.assert_allclose(flat.sd[group], [0.01, 0.01], rtol=0.2, err_msg=group)
+    shifted = _symmetric_set(0.01)
+    pairs = reciprocity.mirror_pairs(shifted)
+    high = pairs[np.abs(shifted.theta_r[pairs[:, 1]]) >= 40, 1]
+    from spacepol.observables.mueller import GROUPS, index
+
+    for element in GROUPS["lin"]:  # what an anisotropy odd in dphi does to a pair: each lin element shifted by 5 sigma
+        shifted.mueller[index(element) + (high,)] += 0.05 * np.sign(rng.standard_normal(high.size))
+    raised = reciprocity.mirror_scatter(shifted, edges_deg=(0, 40, 90))
+    assert raised.sd["lin"][1] > 1.5 * flat.sd["lin"][1] and abs(raised.sd["lin"][0] / flat.sd["lin"][0] - 1) < 0.05
+    assert scatter.labels() == ["0-40 deg", "40-90 deg"]
+    with pytest.raises(ValueError, match="needs the Mueller matrix"):
+        reciprocity.mirror_scatter(Dataset(data.theta_i, data.theta_r, data.dphi, dop=np.zeros_like(tr)))

@@ -169,6 +169,59 @@ def mirror_asymmetry(data, noise: dict, alpha: float = 1e-3, tolerance_deg: floa
     return MirrorAsymmetry(pairs=pairs, chi2=chi2, flagged=chi2 > limit, alpha=alpha)
 
 
+EXIT_EDGES_DEG = (0.0, 20.0, 40.0, 60.0, 90.0)
+_MAD_TO_SD = 1.4826  # a Gaussian's SD over the median absolute deviation
+MIN_SCATTER_DIFFERENCES = 30  # fewer differences in a bin than this: no figure for it
+
+
+@dataclass
+class MirrorScatter:
+    """Per element group, the spread of one measurement of a normalised element, told by the mirror pairs in bins of
+    the exit angle |theta_r| (``edges_deg``): the robust SD of m(b) - D m(a) D over sqrt(2) (median absolute
+    deviation, scaled to a Gaussian's SD). Noise and anisotropy both add to it, so it is an upper bound of the noise
+    in each bin; unlike the reciprocal pairs, which a measurement holds at few angles, it covers every exit angle
+    with a mirror pair. ``sd[group]`` and ``count[group]``: one value per bin (NaN where a bin holds fewer than
+    ``MIN_SCATTER_DIFFERENCES`` differences)."""
+
+    edges_deg: tuple
+    sd: dict
+    count: dict
+
+    def bin_of(self, theta_r_deg) -> np.ndarray:
+        """The bin of each exit angle (|theta_r|; -1 outside the edges)."""
+        t = np.abs(np.asarray(theta_r_deg, float))
+        edges = np.asarray(self.edges_deg)
+        out = np.searchsorted(edges, t, side="right") - 1
+        out[t == edges[-1]] = len(edges) - 2
+        return np.where((t < edges[0]) | (t > edges[-1]), -1, out)
+
+    def labels(self) -> list[str]:
+        """The bins as text ("0-20 deg", ...)."""
+        return [f"{lo:g}-{hi:g} deg" for lo, hi in zip(self.edges_deg[:-1], self.edges_deg[1:])]
+
+
+def mirror_scatter(data, edges_deg=EXIT_EDGES_DEG, tolerance_deg: float = 0.01) -> MirrorScatter:
+    """``MirrorScatter`` of ``data`` (one wavelength; needs the Mueller matrix): how the measurement's own spread
+    changes with the exit angle, where the reciprocal pairs cannot tell."""
+    if data.mueller is None:
+        raise ValueError("mirror_scatter needs the Mueller matrix")
+    pairs = mirror_pairs(data, tolerance_deg)
+    d = _mirror_differences(_normalised(data), pairs)
+    scatter = MirrorScatter(edges_deg=tuple(float(e) for e in edges_deg), sd={}, count={})
+    bins = scatter.bin_of(np.asarray(data.theta_r, float)[pairs[:, 0]] if len(pairs) else np.empty(0))
+    for group, members in GROUPS.items():
+        values = np.stack([d[index(e)] for e in members])
+        sds, counts = [], []
+        for b in range(len(edges_deg) - 1):
+            x = values[:, bins == b].ravel()
+            x = x[np.isfinite(x)]
+            counts.append(int(x.size))
+            sds.append(_MAD_TO_SD * float(np.median(np.abs(x))) / np.sqrt(2.0) if x.size >= MIN_SCATTER_DIFFERENCES
+                       else float("nan"))
+        scatter.sd[group], scatter.count[group] = np.array(sds), np.array(counts)
+    return scatter
+
+
 def symmetry_findings(symmetry: dict, measured: dict | None = None) -> list[str]:
     """In words, what ``symmetry_checks`` found: the noise the mirror pairs bound per element group (beside
     ``measured``, {group: the noise the reciprocal pairs measured}, where given), and the part of the data at

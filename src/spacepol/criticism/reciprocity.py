@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..infer.measured_noise import RECIPROCITY_SIGNS, mirror_pairs, reciprocal_pairs
+from ..infer.measured_noise import RECIPROCITY_SIGNS, mirror_pairs, reciprocal_pairs, sd_from_pair_differences
 from ..observables.mueller import GROUPS, index
 from ..physics.geometry import Geometry
 
@@ -170,7 +170,6 @@ def mirror_asymmetry(data, noise: dict, alpha: float = 1e-3, tolerance_deg: floa
 
 
 EXIT_EDGES_DEG = (0.0, 20.0, 40.0, 60.0, 90.0)
-_MAD_TO_SD = 1.4826  # a Gaussian's SD over the median absolute deviation
 MIN_SCATTER_DIFFERENCES = 30  # fewer differences in a bin than this: no figure for it
 
 
@@ -216,8 +215,7 @@ def mirror_scatter(data, edges_deg=EXIT_EDGES_DEG, tolerance_deg: float = 0.01) 
             x = values[:, bins == b].ravel()
             x = x[np.isfinite(x)]
             counts.append(int(x.size))
-            sds.append(_MAD_TO_SD * float(np.median(np.abs(x))) / np.sqrt(2.0) if x.size >= MIN_SCATTER_DIFFERENCES
-                       else float("nan"))
+            sds.append(sd_from_pair_differences(x) if x.size >= MIN_SCATTER_DIFFERENCES else float("nan"))
         scatter.sd[group], scatter.count[group] = np.array(sds), np.array(counts)
     return scatter
 

@@ -116,6 +116,12 @@ def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict
     return out
 
 
+def sd_from_pair_differences(differences) -> float:
+    """The robust SD of one measurement from differences of pairs that should be equal: their median absolute value
+    scaled to a Gaussian's SD, over sqrt(2) (each difference holds two measurements' noise)."""
+    return _MAD_TO_SIGMA * float(np.median(np.abs(differences))) / np.sqrt(2.0)
+
+
 def measure(likelihood) -> dict[str, MeasuredNoise]:
     """{noise parameter: MeasuredNoise} for the likelihood's inferred noise levels that the data measure
     themselves (at least ``MIN_DIFFERENCES`` finite differences)."""
@@ -131,10 +137,11 @@ def measure(likelihood) -> dict[str, MeasuredNoise]:
         d = np.concatenate(list(parts.values())) if parts else np.empty(0)
         if d.size < MIN_DIFFERENCES:
             continue
-        value = _MAD_TO_SIGMA * float(np.median(np.abs(d))) / np.sqrt(2.0)
+        value = sd_from_pair_differences(d)
         if value > 0:
             out[parameter] = MeasuredNoise(parameter, value, int(d.size), source)
     return out
 
 
-__all__ = ["MeasuredNoise", "RECIPROCITY_SIGNS", "measure", "mirror_pairs", "reciprocal_pairs", "repeated_pairs"]
+__all__ = ["MeasuredNoise", "RECIPROCITY_SIGNS", "measure", "mirror_pairs", "reciprocal_pairs", "repeated_pairs",
+           "sd_from_pair_differences"]

@@ -4,6 +4,8 @@ Checked against emcee on a near-Gaussian posterior (tolerances from both posteri
 ArviZ's PSIS-LOO where the proposal is the posterior itself, and refused where the posterior is not Gaussian (the
 k_s / rho_d ridge of DOP-only data: the negative control)."""
 
+import re
+
 import arviz as az
 import numpy as np
 import pytest
@@ -49,11 +51,27 @@ def at_bound():
 
 def test_a_parameter_at_its_bound_is_sampled_in_the_declared_parameters_and_agrees_with_emcee(at_bound):
     """k piles at 0: the t at the logit-CDF mode is refused (its Pareto k > 0.7, the control), the adapted mixture in
-    the declared parameters is accepted and agrees with emcee."""
+    the declared parameters is trusted by its weights and its draws agree with emcee's. The engine accepts them, or
+    refuses them by the walkers' spread alone with no SD grown beyond what the check's own noise gives (that check
+    sits at 1.08 with SEs of 0.02-0.03 per SD here, so a right proposal is refused now and then: a refusal costs
+    time, never a wrong posterior)."""
     post, centre, approx, exact = at_bound
     assert exact.summary.parameters["k"]["q05"] < 0.01  # the posterior does reach the bound
-    assert approx is not None and "declared parameters" in approx.draws.info["proposal"]
-    _assert_agreement(post, centre, approx, exact)
+    sample = laplace_importance(post, centre, np.random.default_rng(1))
+    assert sample.reliable and "declared parameters" in sample.proposal, sample.refusal
+    e = exact.draws.flat_samples()
+    a = sample.theta[sample.resample(np.random.default_rng(2), 4000)]
+    ess = min(exact.summary.diagnostics["ess_min"], sample.effective_draws)
+    shift, ratio = np.abs(a.mean(0) - e.mean(0)) / e.std(0), a.std(0) / e.std(0)
+    assert np.all(shift < 4 * np.sqrt(2 / ess)), dict(zip(post.names, shift))
+    assert np.all(np.abs(ratio - 1) < 4 * np.sqrt(1 / ess)), dict(zip(post.names, ratio))
+    if approx is not None:
+        assert "declared parameters" in approx.draws.info["proposal"]
+        _assert_agreement(post, centre, approx, exact)
+    else:
+        _, why = laplace_fit(post, centre, seed=1)
+        grown = [float(x) for x in re.findall(r"(\d+\.\d+)x >", why)]
+        assert "spread beyond them" in why and grown and max(grown) < 1.2, why
     in_z = laplace_importance(post, centre, np.random.default_rng(1), adapt=False)
     assert in_z is not None and not in_z.reliable and in_z.pareto_k > 0.7, in_z.pareto_k
     assert f"Pareto k {in_z.pareto_k:.2f} > 0.7" in in_z.refusal

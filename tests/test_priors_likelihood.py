@@ -127,21 +127,23 @@ def test_normalised_stokes_observables():
 
 
 def test_large_batches_are_blocked_and_padded_without_changing_a_value():
-    """A call with thousands of sets goes through the compiled sizes in blocks (a remainder padded with a valid
-    set): every value equals the same set's value evaluated on its own, a length-1 column is shared by all
-    blocks, and the block sizes follow the documented rule."""
-    from spacepol.infer.likelihood import _block_rows
+    """A call with thousands of sets goes through the compiled block of 16 sets (a remainder padded with a valid
+    set), and through a block of 256 once the likelihood has evaluated enough sets in large calls to pay for its
+    compilation: every value equals the same set's value evaluated on its own, the two block sizes agree, a
+    length-1 column is shared by all blocks, and the block sizes follow the documented rule."""
+    from spacepol.infer.likelihood import _SETS_PAYING_A_COMPILATION, _block_rows
     from spacepol.physics.geometry import default_grid
 
-    assert [_block_rows(n, [16, 64, 256, 1024, 4096]) for n in (5, 17, 300, 512, 800, 5000)] == [16, 64, 256, 256, 1024, 4096]
-    assert [_block_rows(n, [16, 64, 256]) for n in (300, 1000)] == [256, 256]
+    assert [_block_rows(n, [16]) for n in (5, 17, 300)] == [16, 16, 16]
+    assert [_block_rows(n, [16, 256]) for n in (40, 200, 300, 512)] == [16, 256, 256, 256]
+    assert [_block_rows(n, [16, 32]) for n in (20, 30, 100)] == [16, 32, 32]
     model, g = Model.from_string("paper"), default_grid()
     data = Dataset(g.theta_i, g.theta_r, g.dphi)
     data.dop, data.dop_err = model.evaluate({}, g).dop, np.full(g.size, 0.01)
     lik = Likelihood(data, model)
-    assert lik.batch_sets == 4096  # 84 points: blocks above 256 allowed
+    assert lik.batch_sets % 16 == 0 and 0.99e6 < lik.batch_sets * lik.numbers_per_set <= 4e6
     rng = np.random.default_rng(5)
-    n_sets = 5000  # one block of 4,096 and a remainder of 904 padded to 1,024
+    n_sets = 5000  # 312 blocks of 16 and a remainder of 8 padded to 16
     sets = {"n": rng.uniform(1.2, 2.5, n_sets), "k": rng.uniform(0, 3, n_sets), "sigma": rng.uniform(0.1, 0.5, n_sets),
             "ks": rng.uniform(0.1, 0.9, n_sets), "rho_d": np.array([0.2])}
     total = lik.total(sets)
@@ -149,6 +151,11 @@ def test_large_batches_are_blocked_and_padded_without_changing_a_value():
     alone = [lik.total({**{k: v[i : i + 1] for k, v in sets.items() if k != "rho_d"}, "rho_d": 0.2})[0] for i in picks]
     np.testing.assert_allclose(total[picks], alone, rtol=1e-12)
     assert np.all(np.isfinite(total)) and len(np.unique(total)) > n_sets // 2  # negative control: sets differ
+    assert lik._compiled_sizes() == [16]
+    for _ in range(_SETS_PAYING_A_COMPILATION // n_sets):
+        lik.total(sets)
+    assert lik._compiled_sizes() == [16, 256]  # 19 blocks of 256 and a remainder of 136 in blocks of 16
+    np.testing.assert_allclose(lik.total(sets), total, rtol=1e-12)
 
 
 def _mueller_set(size: int):
@@ -167,8 +174,8 @@ def _mueller_set(size: int):
 
 def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
     """Full Mueller on 300 geometries: calls of 5, 40 and 100 sets all go through the one compiled block of 16
-    (padded with a valid set), each value equal to that set evaluated alone; a small likelihood (the negative
-    control) compiles a size per call instead."""
+    (padded with a valid set), each value equal to that set evaluated alone, and no larger block is compiled however
+    many sets it has evaluated; a small likelihood (the negative control) compiles the block of 256 once it has."""
     model, data = _mueller_set(300)
     lik = Likelihood(data, model, observables=["mueller"])
     assert lik.compiles_one_block
@@ -196,7 +203,12 @@ def test_a_large_likelihood_compiles_one_block_size_and_keeps_every_value():
     for m in (5, 40, 100):
         small.total({k: v[:m] for k, v in sets.items()})
     (key, jitted), = small._jitted.items()
-    assert jitted._cache_size() == 3
+    assert jitted._cache_size() == 1
+    # the count of sets evaluated in large calls, as a long run leaves it
+    small._sets_in_large_calls = lik._sets_in_large_calls = 10**6
+    small.total({k: np.resize(v, 300) for k, v in sets.items()})
+    assert jitted._cache_size() == 2 and small._compiled_sizes() == [16, 256]
+    assert lik._compiled_sizes() == [16, 1024]  # the large one: its block and the exact size only
     few = {k: v[:5] for k, v in sets.items()}
     np.testing.assert_allclose(small.pointwise(few).sum(axis=1), small.total(few), rtol=1e-12)
     assert len(small._jitted) == 2  # negative control: the small likelihood's total is a program of its own

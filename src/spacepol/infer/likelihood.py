@@ -27,14 +27,15 @@ from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
 
 _CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
-# the only batch sizes compiled: an emcee half-ensemble, a DE generation, larger batches in blocks; every other
-# size would be a compilation of its own. Blocks above 256 sets only where ``batch_sets`` allows them (small data
-# sets): a call's fixed cost exceeds what 256 sets of a small DOP set take (``benchmarks/forward_speed.py``)
-_BATCH_SIZES = (16, 64, 256, 1024, 4096)
-_ALWAYS_UP_TO = 256
-# a likelihood whose smallest block (16 sets) holds at least this many numbers is compiled for that block and the
-# caller's exact sizes only: a compilation of a full-Mueller program costs more than many calls of 16 sets, so
-# the fixed cost of more calls is lost in it
+# every likelihood compiles one block of 16 sets (and the callers' exact sizes, e.g. emcee's half-ensemble); a call of
+# more sets goes through it in blocks. Each further size is a compilation of its own (the largest part of a
+# diagnosis on a small data set: ``benchmarks/diagnose_cost_ratio.py --profile``), so the larger block is compiled
+# only once the sets this likelihood has evaluated in calls of at least its size would have paid for it about twice
+# over: on the 84-point DOP set a set costs ~4x less in blocks of 256 than in blocks of 16, and the block's compilation
+# as much as ~25,000 sets in blocks of 16 (``benchmarks/likelihood_blocks.py``)
+_BLOCK_SETS = 16
+_LARGE_BLOCK_SETS = 256
+_SETS_PAYING_A_COMPILATION = 50_000
 _ONE_BLOCK_NUMBERS = 1 << 15
 # ``total`` reads a large likelihood's pointwise program where a call's block holds at most this many numbers: beyond
 # it the unfused values no longer stay in the cache (all of PTFE, 7,296 geometries x 16 elements, ``paper`` at four
@@ -43,12 +44,12 @@ _POINTWISE_NUMBERS = 4_000_000
 
 
 def _block_rows(n_sets: int, sizes: list) -> int:
-    """Sets per compiled call: the smallest compiled size that holds them all, if it is one of the small ones
-    (a call's fixed cost outweighs their padding) or padding wastes at most a quarter of it; else blocks of the
-    largest size that fits (512 sets: two calls of 256, not one of 1,024)."""
+    """Sets per compiled call: the smallest compiled size that holds them all where padding wastes at most a quarter
+    of it (or no size is smaller), else blocks of the largest size that fits (40 sets: three calls of 16, not one
+    of 256; 512 sets: two calls of 256)."""
     fit = next((size for size in sizes if size >= n_sets), None)
     below = [size for size in sizes if size <= n_sets]
-    if fit is not None and (fit <= _ALWAYS_UP_TO or fit - n_sets <= fit // 4 or not below):
+    if fit is not None and (fit - n_sets <= fit // 4 or not below):
         return fit
     return below[-1]
 
@@ -119,6 +120,7 @@ class Likelihood:
         # batch sizes a caller will use again and again (emcee's half-ensemble): compiled exactly, not padded
         self.exact_sizes: set[int] = set()
         self._sizes_for, self._sizes = None, []  # ``_compiled_sizes``'s last answer and the exact sizes it was for
+        self._sets_in_large_calls = 0  # sets evaluated in calls of at least ``_LARGE_BLOCK_SETS`` (``_compiled_sizes``)
 
     @property
     def numbers_per_set(self) -> int:
@@ -128,16 +130,16 @@ class Likelihood:
     @property
     def batch_sets(self) -> int:
         """How many parameter sets one vectorised evaluation should take: intermediate arrays of
-        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); one of the
-        sizes the likelihood is compiled for."""
-        sets = 4_000_000 // self.numbers_per_set
-        return max([size for size in _BATCH_SIZES if size <= sets] or [_BATCH_SIZES[0]])
+        sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); a multiple of the
+        compiled block of 16 sets."""
+        return max(_BLOCK_SETS, 4_000_000 // self.numbers_per_set // _BLOCK_SETS * _BLOCK_SETS)
 
     @property
     def compiles_one_block(self) -> bool:
-        """Whether calls go through the smallest compiled block (and the caller's ``exact_sizes``) only: where one
-        block's evaluation outweighs a call's fixed cost, every other size would only add a compilation."""
-        return _BATCH_SIZES[0] * self.numbers_per_set >= _ONE_BLOCK_NUMBERS
+        """Whether calls go through the block of 16 sets (and the caller's ``exact_sizes``) only, however many sets they
+        evaluate: where one block's evaluation outweighs a call's fixed cost, a larger block would only add a
+        compilation."""
+        return _BLOCK_SETS * self.numbers_per_set >= _ONE_BLOCK_NUMBERS
 
     @property
     def n_obs(self) -> int:
@@ -224,6 +226,8 @@ class Likelihood:
                 v = np.asarray(v, float).reshape(-1)
                 columns.append((name, v))
                 n_sets = max(n_sets, v.size)
+        if n_sets >= _LARGE_BLOCK_SETS:
+            self._sets_in_large_calls += n_sets
         sizes = self._compiled_sizes()
         rows = _block_rows(n_sets, sizes)
         # ``total`` of a large likelihood: the pointwise program, summed (see ``total``)
@@ -248,13 +252,13 @@ class Likelihood:
         return out.sum(axis=-1) if summed else out
 
     def _compiled_sizes(self) -> list[int]:
-        """The block sizes calls are padded to: the fixed ones this likelihood compiles and the callers' exact sizes
-        (kept until those change: a sampler calls this at every step)."""
-        exact = frozenset(self.exact_sizes)
-        if self._sizes_for != exact:
-            fixed = {size for size in _BATCH_SIZES if size <= max(_ALWAYS_UP_TO, self.batch_sets)
-                     and (size == _BATCH_SIZES[0] or not self.compiles_one_block)}
-            self._sizes_for, self._sizes = exact, sorted(fixed | exact)
+        """The block sizes calls are padded to: 16 sets, the callers' exact sizes, and 256 sets once the sets this
+        likelihood evaluated in calls of that size would have paid for its compilation (never on a large data set:
+        ``compiles_one_block``). Kept until these change: a sampler calls this at every step."""
+        large = not self.compiles_one_block and self._sets_in_large_calls >= _SETS_PAYING_A_COMPILATION
+        state = (frozenset(self.exact_sizes), large)
+        if self._sizes_for != state:
+            self._sizes_for, self._sizes = state, sorted({_BLOCK_SETS, *([_LARGE_BLOCK_SETS] if large else []), *state[0]})
         return self._sizes
 
     def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):

@@ -213,6 +213,23 @@ def _sky_commands(sub) -> None:
     p.add_argument("--p-max", type=float, default=0.7, help="the sky's maximum degree of polarization (Rayleigh)")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/observe")
+    p = sub.add_parser("synth-pass", help="a simulated measured light curve (flux, DoLP, AoP) of a target over a pass")
+    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
+    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
+    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
+    p.add_argument("--start", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2014-01-21T00:33Z")
+    p.add_argument("--end", required=True, metavar="ISO8601")
+    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between times")
+    p.add_argument("--target", required=True, metavar="FILE.toml",
+                   help="[[faces]], each with its material table; an optional attitude = {yaw_deg, pitch_deg, roll_deg}")
+    p.add_argument("--camera", default=None, metavar="FILE.toml", help="[camera] (default: an IMX250MZR-class sensor)")
+    p.add_argument("--exposures", type=_int_at_least(1), default=None, metavar="N",
+                   help="frames averaged per time step (default: as many as fill the step)")
+    p.add_argument("--sky-zenith-mag", type=float, default=5.40, metavar="MAG",
+                   help="the sky's radiance at the zenith in the band, mag arcsec^-2 (default 5.40, the paper's)")
+    p.add_argument("--seed", type=SEED, default=0)
+    p.add_argument("--out", required=True, metavar="FILE.csv", help="the light curve: time_utc,flux,flux_err,dolp,...")
+    p.set_defaults(command="synth_pass")
     p = sub.add_parser("frame", help="a raw micro-polarizer frame (IMX250MZR mosaic) as Stokes, DoLP and AoP maps")
     p.add_argument("raw", metavar="RAW.png", help="an 8- or 16-bit single-channel image of the raw mosaic")
     p.add_argument("--method", choices=("superpixel", "bilinear"), default="superpixel")

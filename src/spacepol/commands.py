@@ -316,6 +316,18 @@ def observe(args) -> int:
     return 0
 
 
+def synth_pass(args) -> int:
+    """``invert-mcmc synth-pass``: a simulated light curve of a target over a pass (``api.synth_pass``)."""
+    from .api import synth_pass as render
+
+    curve = render(args.tle, args.site, args.start, args.end, target=args.target, step_s=args.step,
+                   satellite=args.satellite, camera=args.camera, seed=args.seed, exposures_per_step=args.exposures,
+                   sky_magnitude_zenith=args.sky_zenith_mag, out=args.out)
+    print(f"{len(curve)} times with the target above the horizon, sunlit and turning a lit face to the site "
+          f"({curve.times_utc[0]:%H:%M:%S} to {curve.times_utc[-1]:%H:%M:%S} UTC); wrote {args.out}")
+    return 0
+
+
 def frame(args) -> int:
     """``invert-mcmc frame``: a raw frame's maps (``api.frame``); prints their DoLP."""
     from .api import frame as read_frame

@@ -87,7 +87,7 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
     if irradiance_w_m2 is not None:
         photons *= irradiance_w_m2 / irradiance
         irradiance = irradiance_w_m2
-    names = {p.name for p in model.parameters}
+    names = {p.name for p in model.parameters} if model is not None else set()  # None: every face has its material
     params = {k: np.atleast_1d(np.asarray(v, float)) for k, v in draws.items() if k in names}
     n_draws = max((len(v) for v in params.values()), default=1)
     n_times = len(geometry.times_utc)

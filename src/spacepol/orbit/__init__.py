@@ -2,8 +2,9 @@
 site, the sun, whether the satellite is sunlit and the sky is in daylight, the phase angle, and each face's
 incidence, reflection and azimuth angles in its own frame."""
 
-from .faces import default_faces, faces_from_toml
+from .attitude import Attitude, turned
+from .faces import attitude_from_toml, default_faces, faces_from_toml
 from .pass_geometry import Face, PassGeometry, pass_geometry
 from .tle import TLE, read_tle
 
-__all__ = ["Face", "PassGeometry", "TLE", "default_faces", "faces_from_toml", "pass_geometry", "read_tle"]
+__all__ = ["Attitude", "attitude_from_toml", "turned", "Face", "PassGeometry", "TLE", "default_faces", "faces_from_toml", "pass_geometry", "read_tle"]

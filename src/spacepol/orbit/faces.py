@@ -9,6 +9,7 @@ import tomllib
 from pathlib import Path
 
 from ..errors import ParameterError
+from .attitude import Attitude, attitude_from_table
 from .pass_geometry import Face
 
 FACE_KEYS = {"name", "area_m2", "orientation", "normal", "material"}
@@ -22,16 +23,27 @@ def default_faces() -> list[Face]:
     return [Face(name, 1.0, "nadir", normal) for name, normal in axes.items()] + [Face("solar_panel", 4.0, "sun")]
 
 
+def _read(path: Path) -> dict:
+    if not path.is_file():
+        raise ParameterError(f"--target {path}: file not found")
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"--target {path}: not valid TOML ({exc})") from None
+
+
+def attitude_from_toml(path) -> Attitude | None:
+    """The target file's top-level ``attitude = {yaw_deg, pitch_deg, roll_deg}`` offsets, None where it has none."""
+    path = Path(path)
+    table = _read(path).get("attitude")
+    return None if table is None else attitude_from_table(table, f"--target {path}")
+
+
 def faces_from_toml(path) -> list[Face]:
     """The ``[[faces]]`` of a target TOML file; an unknown key, a missing area or a bad value is one line naming the
     face."""
     path = Path(path)
-    if not path.is_file():
-        raise ParameterError(f"--target {path}: file not found")
-    try:
-        tables = tomllib.loads(path.read_text(encoding="utf-8")).get("faces")
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ParameterError(f"--target {path}: not valid TOML ({exc})") from None
+    tables = _read(path).get("faces")
     if not isinstance(tables, list) or not tables:
         raise ParameterError(f"--target {path}: no [[faces]] tables (each with name, area_m2, orientation, normal)")
     faces = []

@@ -230,6 +230,23 @@ def _sky_commands(sub) -> None:
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", required=True, metavar="FILE.csv", help="the light curve: time_utc,flux,flux_err,dolp,...")
     p.set_defaults(command="synth_pass")
+    p = sub.add_parser("lightcurve", help="a satellite's material and attitude from its measured light curve")
+    p.add_argument("curve", metavar="FILE.csv", help="time_utc and any of flux, dolp, aop_deg with their _err columns")
+    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
+    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
+    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
+    p.add_argument("--start", required=True, metavar="ISO8601", help="the pass window's start, with UTC offset")
+    p.add_argument("--end", required=True, metavar="ISO8601")
+    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between the window's times")
+    p.add_argument("--target", required=True, metavar="FILE.toml",
+                   help="[[faces]]: those without a material table are of the unknown material; an optional attitude "
+                        "table fixes the offsets (inferred where absent)")
+    p.add_argument("--materials", required=True, metavar="NAME,...",
+                   help="candidate materials: aluminium, kapton, white_paint, solar_glass")
+    p.add_argument("--observables", default=None, metavar="NAME,...", help="flux, dolp, aop (default: all the file holds)")
+    p.add_argument("--steps", type=_int_at_least(100), default=3000, help="emcee steps per material (the second half kept)")
+    p.add_argument("--seed", type=SEED, default=0)
+    p.add_argument("--out", default=None, help="default: a folder named after the CSV, beside it")
     p = sub.add_parser("frame", help="a raw micro-polarizer frame (IMX250MZR mosaic) as Stokes, DoLP and AoP maps")
     p.add_argument("raw", metavar="RAW.png", help="an 8- or 16-bit single-channel image of the raw mosaic")
     p.add_argument("--method", choices=("superpixel", "bilinear"), default="superpixel")

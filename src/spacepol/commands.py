@@ -328,6 +328,24 @@ def synth_pass(args) -> int:
     return 0
 
 
+def lightcurve(args) -> int:
+    """``invert-mcmc lightcurve``: materials ranked and the attitude from a light curve (``api.invert_lightcurve``)."""
+    from .api import invert_lightcurve
+
+    out = check_output_dir(Path(args.out) if args.out else Path(args.curve).with_suffix(""))
+    inversion = invert_lightcurve(args.curve, args.tle, args.site, args.start, args.end, target=args.target,
+                                  materials=args.materials, step_s=args.step, satellite=args.satellite,
+                                  observables=args.observables.split(",") if args.observables else None,
+                                  seed=args.seed, steps=args.steps, out=out, progress=True)
+    for row in inversion.ranking:
+        print(f"{row['material']:<12s} ELPD-LOO {row['elpd']:12.1f} +- {row['elpd_se']:.1f}   "
+              f"delta {row['delta_elpd']:12.1f} +- {row['delta_elpd_se']:.1f}")
+    for name, q in inversion.to_json()["attitude"].items():
+        print(f"{name} {q['median']:.2f} [90 %: {q['q05']:.2f}, {q['q95']:.2f}]")
+    print(f"wrote {out}/lightcurve.json, light_curve.png, report.html")
+    return 0
+
+
 def frame(args) -> int:
     """``invert-mcmc frame``: a raw frame's maps (``api.frame``); prints their DoLP."""
     from .api import frame as read_frame

@@ -16,10 +16,11 @@ from .inversion import invert, calibrate, optimize, compare, Comparison
 from .forward import forward, synth
 from .observing import Contrast, contrast, observe, frame, Sky, sky
 from .criticism import Diagnosis, diagnose, Ladder, ladder, Design, design
-from .light_curves import synth_pass
+from .light_curves import invert_lightcurve, synth_pass
 
 __all__ = [
     "synth_pass",
+    "invert_lightcurve",
     "parse_wavelengths",
     "load",
     "build_model",

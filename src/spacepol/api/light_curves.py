@@ -1,8 +1,10 @@
 """A satellite's polarimetric light curve: ``synth_pass`` renders one through the chain (the pass's geometry, the
-target's faces and their materials, the sun, the sky and a micro-polarizer camera's noise)."""
+target's faces and their materials, the sun, the sky and a micro-polarizer camera's noise); ``invert_lightcurve``
+reads the material and the attitude back from one."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -63,3 +65,110 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
     if out is not None:
         write_light_curve(out, curve)
     return curve
+
+
+def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s: float = 10.0,
+                      observables=None, satellite: str | None = None, seed: int = 0, steps: int = 3000,
+                      band_um=(1.5, 1.8), out=None, progress: bool = False):
+    """A satellite's material and attitude from its light curve (``curve``: a LightCurve or its CSV file), measured
+    from ``site`` in the window ``start``-``end`` (its times must lie inside it; ``step_s`` the window's grid, checked)
+    of the satellite of ``tle``. ``target``: a TOML file of faces; those without a material table are made of the
+    unknown material, and a top-level ``attitude`` table fixes the offsets (inferred, within 60 deg, where absent).
+    For each name of ``materials`` (``detect.materials.LIBRARY``) the joint posterior of its parameters and the
+    offsets (emcee, ``steps``), ranked by ELPD-LOO over ``observables`` (flux, dolp, aop; default all the file
+    holds). Returns the ``detect.light_curve_inversion.LightCurveInversion``; with ``out`` lightcurve.json,
+    light_curve.png, attitude_corner.png and report.html."""
+    from ..detect.light_curve_inversion import LightCurveInversion, check_observables, fit_material
+    from ..detect.light_curve_model import LightCurveModel
+    from ..orbit import attitude_from_toml, faces_from_toml
+
+    if out is not None:
+        from ..io.output import check_output_dir
+
+        out = check_output_dir(Path(out))
+    site = parse_site(site)
+    if not (isinstance(steps, int) and steps >= 100):
+        raise ParameterError(f"--steps {steps}: need a whole number of at least 100")
+    candidates = _candidates(materials, band_um)  # an unknown name: one line, before any work
+    curve = _curve_in_window(curve, start, end, step_s)
+    observables = check_observables(curve, observables)
+    faces, attitude = faces_from_toml(target), attitude_from_toml(target)
+    geometry, element_set = _visible_geometry(curve, tle, satellite, site, faces)
+    rng = np.random.default_rng(seed)
+    fits = []
+    for candidate in candidates:
+        if progress:
+            print(f"lightcurve: {candidate.name} ({candidate.description})", file=sys.stderr)
+        model = LightCurveModel(geometry, candidate, attitude, band_um)
+        fits.append(fit_material(model, curve, observables, rng.spawn(1)[0], steps=steps, progress=progress))
+    notes = _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, steps)
+    inversion = LightCurveInversion(curve, fits, observables, notes)
+    if out is not None:
+        from ..report.light_curve_report import write_light_curve_report
+
+        write_light_curve_report(inversion, out)
+    return inversion
+
+
+def _candidates(materials, band_um) -> list:
+    from ..detect.materials import material
+
+    names = [m.strip() for m in (materials.split(",") if isinstance(materials, str) else materials) if m.strip()]
+    if not names:
+        raise ParameterError("--materials: name at least one material")
+    return [material(name, 0.5 * (band_um[0] + band_um[1])) for name in names]
+
+
+def _curve_in_window(curve, start, end, step_s: float) -> LightCurve:
+    """The light curve (read where a path), each of its times inside the window; else one line."""
+    from ..io.light_curve import read_light_curve
+    from ..orbit.pass_geometry import time_steps
+    from ..skylight.sun import parse_time
+
+    window = time_steps(start, end, step_s)
+    if not isinstance(curve, LightCurve):
+        curve = read_light_curve(curve)
+    last = parse_time(end) if isinstance(end, str) else end
+    outside = [t for t in curve.times_utc if not window[0] <= t <= last]
+    if outside:
+        raise ParameterError(f"{curve.source}: time {outside[0]:%Y-%m-%dT%H:%M:%SZ} lies outside the pass window "
+                             f"{start} - {end}")
+    return curve
+
+
+def _visible_geometry(curve, tle, satellite, site, faces):
+    """(the pass's geometry at the curve's times, the element set); one line where the satellite cannot be seen at
+    any measured time (below the horizon or in Earth's shadow), or at some of them."""
+    from ..orbit import read_tle
+    from ..orbit.pass_geometry import pass_geometry_at
+
+    element_set = read_tle(tle, satellite)
+    geometry = pass_geometry_at(element_set, site, curve.times_utc, faces)
+    hidden = np.flatnonzero(~((geometry.elevation_deg > 0) & geometry.sunlit))
+    if hidden.size == len(curve):
+        raise ParameterError(f"{element_set.name}: below the horizon or in Earth's shadow at every time of "
+                             f"{curve.source}: the elements, the site or the times do not belong together")
+    if hidden.size:
+        raise ParameterError(f"{curve.source}: at {curve.times_utc[hidden[0]]:%Y-%m-%dT%H:%M:%SZ} (and {hidden.size - 1} "
+                             f"more) {element_set.name} is below the horizon or in Earth's shadow, yet light was "
+                             "measured: the elements, the site or the times do not belong together")
+    return geometry, element_set
+
+
+def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, steps) -> list[str]:
+    from ..detect.light_curve_model import ATTITUDE_LIMIT_DEG
+
+    unknown_faces = [f.name for f in faces if f.material is None]
+    return [
+        f"Satellite {element_set.name} from {element_set.source} (SGP4, skyfield), site {site[0]:.4f}, {site[1]:.4f} deg, "
+        f"{site[2]:g} m; {len(curve)} measured times between {start} and {end}.",
+        f"Target: {len(faces)} faces; of the unknown material: {', '.join(unknown_faces) or 'none'}; shadows between "
+        "faces and light reflected between them are left out.",
+        ("Attitude: offsets known from the target file: " + ", ".join(f"{k} {v:g}" for k, v in attitude.to_json().items())
+         if attitude is not None else f"Attitude: yaw, pitch and roll offsets inferred, each uniform within "
+         f"{ATTITUDE_LIMIT_DEG:g} deg of the nominal orientation (z-y-x about the orbit frame)."),
+        f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um; fitted: {', '.join(observables)}, each "
+        "Gaussian with the file's errors (AoP on its 180-deg circle).",
+        f"Posterior: emcee, {steps} steps (the second half kept), walkers started about the best local optimum of a "
+        "prior scan; ELPD-LOO by PSIS over the measured points.",
+    ]

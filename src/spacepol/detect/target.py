@@ -70,7 +70,7 @@ def sky_basis(geometry) -> tuple[np.ndarray, np.ndarray]:
     return s, np.cross(d.T, s.T).T
 
 
-def _rotation_to_sky(normals: np.ndarray, to_observer: np.ndarray, s_sky: np.ndarray) -> np.ndarray:
+def rotation_to_sky(normals: np.ndarray, to_observer: np.ndarray, s_sky: np.ndarray) -> np.ndarray:
     """The angle (rad) that turns a face's s vector (n x d) into the sky's ``s_sky`` about d, per time (3, T) inputs."""
     s_face = np.cross(normals.T, to_observer.T).T
     s_face /= np.maximum(np.linalg.norm(s_face, axis=0), 1e-300)
@@ -108,7 +108,7 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         ti, tr = np.radians(geometry.theta_i_deg[times, faces]), np.radians(geometry.theta_r_deg[times, faces])
         scale = irradiance * np.cos(ti) * area * np.cos(tr) / (geometry.range_km[times] * 1e3) ** 2
         normals = np.stack([geometry.normals(k) for k in range(len(geometry.faces))], axis=-1)  # (3, T, faces)
-        psi = _rotation_to_sky(normals[:, times, faces], geometry.to_observer_unit[:, times], s_sky[:, times])
+        psi = rotation_to_sky(normals[:, times, faces], geometry.to_observer_unit[:, times], s_sky[:, times])
         c, sn = np.cos(2 * psi), np.sin(2 * psi)
         rotated = np.stack([sr[0], c * sr[1] + sn * sr[2], -sn * sr[1] + c * sr[2], sr[3]]) * scale
         for component in range(4):  # faces seen at the same time add up

@@ -63,6 +63,13 @@ class RefractiveIndex:
         if self._n is None and self._formula is None:
             raise InputFileError(self.path, "no refractive index data found")
 
+    @property
+    def range_um(self) -> tuple[float, float]:
+        """(shortest, longest) wavelength in um at which the file gives n."""
+        if self._formula is not None:
+            return self._formula[1], self._formula[2]
+        return float(self._n[0, 0]), float(self._n[-1, 0])
+
     def __call__(self, wavelength_um):
         wl = np.asarray(wavelength_um, dtype=float)
         if self._formula is not None:

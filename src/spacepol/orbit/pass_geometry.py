@@ -62,12 +62,18 @@ class Face:
             return sun_unit
         if self.orientation == "inertial":
             return np.repeat(n[:, None], position_km.shape[1], axis=1)
-        z = -position_km / np.linalg.norm(position_km, axis=0)  # towards the Earth's centre
-        y = np.cross(z.T, velocity_km_s.T).T
-        y /= np.linalg.norm(y, axis=0)
-        x = np.cross(y.T, z.T).T  # along the velocity (exactly so on a circular orbit)
+        x, y, z = orbit_axes(position_km, velocity_km_s)
         out = n[0] * x + n[1] * y + n[2] * z
         return out / np.linalg.norm(out, axis=0)
+
+
+def orbit_axes(position_km: np.ndarray, velocity_km_s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The orbit frame's unit axes in GCRS, each (3, N): x along the velocity (exactly so on a circular orbit), y
+    across the orbit (z x v), z towards the Earth's centre."""
+    z = -position_km / np.linalg.norm(position_km, axis=0)
+    y = np.cross(z.T, velocity_km_s.T).T
+    y /= np.linalg.norm(y, axis=0)
+    return np.cross(y.T, z.T).T, y, z
 
 
 @dataclass
@@ -187,13 +193,17 @@ def pass_geometry(tle: TLE, site: tuple, start, end, step_s: float = 10.0, faces
     """The pass of the satellite of ``tle`` over ``site`` (lat_deg, lon_deg[, height_m]) from ``start`` to ``end``
     every ``step_s`` seconds, with each face's angles. One line for a site off the globe, a window far from the
     elements' epoch, or a satellite SGP4 cannot propagate (decayed)."""
+    return pass_geometry_at(tle, site, time_steps(start, end, step_s), faces)
+
+
+def pass_geometry_at(tle: TLE, site: tuple, times: list[datetime], faces=()) -> PassGeometry:
+    """``pass_geometry`` at the given aware ``times`` (e.g. a measured light curve's)."""
     from skyfield.api import EarthSatellite, load, wgs84
 
     lat, lon, height = (tuple(float(v) for v in site) + (0.0,))[:3]
     if not -90.0 <= lat <= 90.0 or not -180.0 <= lon <= 360.0 or not np.isfinite(height):
         raise ParameterError(f"--site {lat:g},{lon:g},{height:g}: latitude in [-90, 90], longitude in [-180, 360] deg, "
                              "height in metres")
-    times = time_steps(start, end, step_s)
     ts = load.timescale(builtin=True)  # leap seconds and Delta T bundled with skyfield: no download
     satellite = EarthSatellite(tle.line1, tle.line2, tle.name, ts)
     t = ts.from_datetimes(times)

@@ -1,0 +1,87 @@
+"""Files of ``invert-mcmc lightcurve``: lightcurve.json, light_curve.png (the measured flux, DoLP and AoP against
+each candidate material's posterior-predictive band), attitude_corner.png (the best material's attitude offsets) and
+report.html."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..io.atomic import atomic_path, save_figure, write_json
+from ..orbit.attitude import ANGLES
+from . import html as H
+
+_PANELS = (("flux", "flux_err", "photons m^-2 s^-1"), ("dolp", "dolp_err", "DoLP"), ("aop_deg", "aop_err_deg", "AoP (deg)"))
+
+
+def light_curve_figure(inversion, fig=None) -> Figure:
+    """Flux, DoLP and AoP against time: the measurements with their errors and, per candidate, the 5-95 %
+    posterior-predictive band (the model plus the measurement's noise) and its median."""
+    curve = inversion.curve
+    minutes = np.array([(t - curve.times_utc[0]).total_seconds() / 60.0 for t in curve.times_utc])
+    fig = fig or Figure(figsize=(8.0, 8.0), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    for ax, (name, err, label) in zip(axes, _PANELS):
+        for k, f in enumerate(inversion.fits):
+            low, median, high = f.bands[name]
+            ax.fill_between(minutes, low, high, color=f"C{k + 1}", alpha=0.25, lw=0)
+            ax.plot(minutes, median, "-", color=f"C{k + 1}", lw=1, label=f.material)
+        if getattr(curve, name) is not None:
+            fitted = "fitted" if name in inversion.observables else "not fitted"
+            ax.errorbar(minutes, getattr(curve, name), getattr(curve, err), fmt=".", color="k", ms=3, lw=0.8,
+                        label=f"measured ({fitted})")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].set_yscale("log")
+    axes[0].legend(fontsize=7)
+    axes[-1].set_xlabel(f"minutes after {curve.times_utc[0].strftime('%Y-%m-%dT%H:%M:%SZ')}")
+    fig.suptitle(f"{curve.source}: posterior-predictive 90 % bands per material", fontsize=10)
+    return fig
+
+
+def attitude_figure(fit) -> Figure | None:
+    """The corner plot of ``fit``'s attitude offsets (None where the attitude was known)."""
+    import corner
+
+    columns = [fit.names.index(a) for a in ANGLES if a in fit.names]
+    if not columns:
+        return None
+    fig = Figure(figsize=(6.0, 6.0))
+    corner.corner(fit.samples[:, columns], labels=[fit.names[j] for j in columns], quantiles=[0.05, 0.5, 0.95],
+                  show_titles=True, fig=fig)
+    return fig
+
+
+def write_light_curve_report(inversion, out: Path) -> dict:
+    """lightcurve.json, light_curve.png, attitude_corner.png (where the attitude was inferred) and report.html in
+    ``out``; returns lightcurve.json's content."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    content = inversion.to_json()
+    write_json(out / "lightcurve.json", content)
+    save_figure(light_curve_figure(inversion), out / "light_curve.png")
+    corner_fig = attitude_figure(inversion.best)
+    if corner_fig is not None:
+        save_figure(corner_fig, out / "attitude_corner.png")
+    rows = [[r["material"], f"{r['elpd']:.1f} +- {r['elpd_se']:.1f}", f"{r['delta_elpd']:.1f} +- {r['delta_elpd_se']:.1f}",
+             f"{content['candidates'][r['material']]['rhat_max']:.3f}"] for r in content["ranking"]]
+    second = content["ranking"][1] if len(content["ranking"]) > 1 else None
+    verdict = f"The light curve reads as {content['best']}"
+    if second is not None:
+        gap = -second["delta_elpd"] / max(second["delta_elpd_se"], 1e-300)
+        verdict += (f", ahead of {second['material']} by {-second['delta_elpd']:.1f} +- {second['delta_elpd_se']:.1f} in "
+                    f"ELPD-LOO ({gap:.1f} SE: {'decisive' if gap >= 2 else 'not decisive'}).")
+    estimates = [[k, f"{v['median']:.4g}", f"[{v['q05']:.4g}, {v['q95']:.4g}]"]
+                 for k, v in (content["attitude"] | content["parameters"]).items()]
+    sections = [("Verdict", H.paragraph(verdict)),
+                ("Materials ranked by ELPD-LOO", H.table(["material", "ELPD-LOO", "delta vs best", "R-hat max"], rows)),
+                (f"{content['best']}: posterior median and 90 % interval", H.table(["parameter", "median", "90 %"], estimates)),
+                ("Light curve", H.image(H.png_file_to_data_uri(out / "light_curve.png")))]
+    if corner_fig is not None:
+        sections.append(("Attitude offsets", H.image(H.png_file_to_data_uri(out / "attitude_corner.png"))))
+    sections.append(("Pass, target and fit", H.bullets(inversion.assumptions)))
+    with atomic_path(out / "report.html") as tmp:
+        tmp.write_text(H.page("spacepol lightcurve", sections), encoding="utf-8")
+    return content

@@ -76,7 +76,8 @@ def rendered(tmp_path_factory):
 
 def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered):
     """Candidates solar_glass (true) and aluminium: the true one first by more than 2 SE of the paired difference;
-    each attitude offset's 90 % interval holds the truth and is narrower than 30 deg; the report's files exist."""
+    each attitude offset's 90 % interval holds the truth and is narrower than 30 deg; the report's files exist; the
+    same command run again continues from the materials already fitted and refits the one whose file is gone."""
     folder, csv, unknown, truth, _ = rendered
     inversion = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, target=unknown, materials="aluminium,solar_glass",
                                            steps=400, seed=1, out=folder / "fit")
@@ -86,7 +87,17 @@ def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered)
     for name, q in inversion.to_json()["attitude"].items():
         assert q["q05"] <= truth[name] <= q["q95"] and q["q95"] - q["q05"] < 30.0, (name, q, truth[name])
     assert {p.name for p in (folder / "fit").iterdir()} == {"lightcurve.json", "light_curve.png", "attitude_corner.png",
-                                                              "report.html"}
+                                                              "report.html", "fits"}
+    # the same command again (as after an interruption) reads the finished materials instead of sampling them again
+    (folder / "fit" / "fits" / "aluminium.npz").unlink()
+    again = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, target=unknown, materials="aluminium,solar_glass",
+                                       steps=400, seed=1, out=folder / "fit")
+    kept = {f.material: f for f in inversion.fits}
+    for f in again.fits:
+        np.testing.assert_array_equal(f.samples, kept[f.material].samples)
+    other = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, target=unknown, materials="solar_glass", steps=400,
+                                       seed=2, out=folder / "fit")  # another seed: the saved fit is not reused
+    assert not np.array_equal(other.fits[0].samples, kept["solar_glass"].samples)
 
 
 @pytest.mark.parametrize("change, words", [

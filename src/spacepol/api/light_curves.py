@@ -35,11 +35,9 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
     from ..orbit.pass_geometry import time_steps
 
     if out is not None:
-        out = Path(out)
-        if out.exists() and out.is_dir():
-            raise ParameterError(f"--out {out}: a folder; give the CSV file's name")
-        if not out.parent.is_dir():
-            raise ParameterError(f"--out {out}: its folder {out.parent} does not exist")
+        from ..io.output import check_output_file
+
+        out = check_output_file(out)
     site = parse_site(site)
     if not (np.isfinite(step_s) and step_s > 0):
         raise ParameterError(f"--step {step_s}: need a number of seconds > 0")
@@ -78,7 +76,7 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
     offsets (emcee, ``steps``), ranked by ELPD-LOO over ``observables`` (flux, dolp, aop; default all the file
     holds). Returns the ``detect.light_curve_inversion.LightCurveInversion``; with ``out`` lightcurve.json,
     light_curve.png, attitude_corner.png and report.html."""
-    from ..detect.light_curve_inversion import LightCurveInversion, check_observables, fit_material
+    from ..detect.light_curve_inversion import LightCurveInversion, MaterialFit, check_observables, fit_material
     from ..detect.light_curve_model import LightCurveModel
     from ..orbit import attitude_from_toml, faces_from_toml
 
@@ -95,12 +93,21 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
     faces, attitude = faces_from_toml(target), attitude_from_toml(target)
     geometry, element_set = _visible_geometry(curve, tle, satellite, site, faces)
     rng = np.random.default_rng(seed)
+    key = _run_key(curve, tle, satellite, site, target, observables, steps, seed, band_um)
     fits = []
     for candidate in candidates:
+        stream = rng.spawn(1)[0]  # drawn for every candidate, fitted or kept, so each gets the same stream
+        kept = None if out is None else MaterialFit.load(out / "fits" / f"{candidate.name}.npz", key)
+        if kept is not None:
+            fits.append(kept)
+            continue
         if progress:
             print(f"lightcurve: {candidate.name} ({candidate.description})", file=sys.stderr)
         model = LightCurveModel(geometry, candidate, attitude, band_um)
-        fits.append(fit_material(model, curve, observables, rng.spawn(1)[0], steps=steps, progress=progress))
+        fits.append(fit_material(model, curve, observables, stream, steps=steps, progress=progress))
+        if out is not None:  # an interrupted run keeps the materials it finished
+            (out / "fits").mkdir(parents=True, exist_ok=True)
+            fits[-1].save(out / "fits" / f"{candidate.name}.npz", key)
     notes = _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, steps)
     inversion = LightCurveInversion(curve, fits, observables, notes)
     if out is not None:
@@ -108,6 +115,15 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
 
         write_light_curve_report(inversion, out)
     return inversion
+
+
+def _run_key(curve, tle, satellite, site, target, observables, steps, seed, band_um) -> str:
+    """A digest of everything a material's fit depends on: a saved fit is reused only for the same inputs."""
+    import hashlib
+
+    parts = [curve.rows(), Path(tle).read_text(encoding="utf-8", errors="replace"), satellite, list(site),
+             Path(target).read_text(encoding="utf-8", errors="replace"), observables, steps, seed, list(band_um)]
+    return hashlib.sha256(repr(parts).encode()).hexdigest()
 
 
 def _candidates(materials, band_um) -> list:

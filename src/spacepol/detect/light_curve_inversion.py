@@ -9,6 +9,7 @@ differential-evolution moves carry them between the attitude's separated solutio
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from dataclasses import dataclass
@@ -68,6 +69,35 @@ class MaterialFit:
     acceptance: float
     bands: dict
     seconds: float
+
+    def save(self, path, key: str) -> None:
+        """This fit in one .npz file (written whole or not at all), labelled with ``key`` (what it was fitted to)."""
+        from ..io.atomic import atomic_path
+
+        scalars = {"material": self.material, "description": self.description, "names": self.names, "key": key,
+                   "rhat_max": self.rhat_max, "ess_min": self.ess_min, "acceptance": self.acceptance,
+                   "seconds": self.seconds, "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
+        arrays = {"samples": self.samples, "pointwise": self.loo["pointwise"], "pareto_k": self.loo["pareto_k"]}
+        arrays |= {f"band_{k}": v for k, v in self.bands.items()}
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as handle:
+                np.savez(handle, scalars=np.array(json.dumps(scalars)), **arrays)
+
+    @classmethod
+    def load(cls, path, key: str) -> "MaterialFit | None":
+        """The fit saved at ``path`` for ``key``; None where there is none, it was fitted to something else, or the
+        file cannot be read (a run killed while writing it)."""
+        try:
+            with np.load(path) as f:
+                scalars = json.loads(str(f["scalars"]))
+                if scalars["key"] != key:
+                    return None
+                bands = {k.removeprefix("band_"): f[k] for k in f.files if k.startswith("band_")}
+                record = scalars["loo"] | {"pointwise": f["pointwise"], "pareto_k": f["pareto_k"]}
+                return cls(scalars["material"], scalars["description"], scalars["names"], f["samples"], record,
+                           scalars["rhat_max"], scalars["ess_min"], scalars["acceptance"], bands, scalars["seconds"])
+        except (OSError, ValueError, KeyError, EOFError):
+            return None
 
     def summary(self) -> dict:
         """{parameter: {median, q05, q95}} over the posterior draws."""
@@ -154,7 +184,9 @@ def _start(model: LightCurveModel, log_prob, rng: np.random.Generator, walkers: 
     rows[d + 1 :] -= np.diag(np.full(d, h))
     v = log_prob(to_theta(np.clip(rows, 1e-12, 1 - 1e-12)))
     curvature = -(v[1 : d + 1] + v[d + 1 :] - 2 * v[0]) / h**2
-    spread = np.where(np.isfinite(curvature) & (curvature > 0), 1.0 / np.sqrt(np.abs(curvature)), 1e-3)
+    usable = np.isfinite(curvature) & (curvature > 0)
+    spread = np.full(d, 1e-3)
+    spread[usable] = 1.0 / np.sqrt(curvature[usable])
     u = best_u + 0.5 * np.minimum(spread, 0.05) * rng.standard_normal((walkers, d))
     return to_theta(np.clip(u, 1e-9, 1 - 1e-9))
 

@@ -20,10 +20,10 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..infer.diagnostics import loo
+from ..orbit.attitude import ANGLES
 from .light_curve_model import LightCurveModel
 
-SCAN = 4096
-STARTS = 4  # the best scan points polished by a local optimizer before the walkers start
+GENERATIONS = 300  # at most, of the differential-evolution search that places the walkers
 DRAWS_FOR_LOO = 2000
 BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
 
@@ -146,18 +146,24 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
 
 
 def _start(model: LightCurveModel, log_prob, rng: np.random.Generator, walkers: int) -> np.ndarray:
-    """(walkers, D) starting points: the best of ``SCAN`` prior draws, each of the ``STARTS`` best polished by
-    L-BFGS-B in the prior's unit cube (forward differences, one batch of D + 1 sets per gradient), the walkers then
-    spread about the best optimum by each coordinate's own curvature there."""
-    from scipy.optimize import minimize
+    """(walkers, D) starting points: the global optimum of a differential-evolution search of the prior's unit cube
+    (scipy, its generations evaluated in blocks), polished by L-BFGS-B (forward differences, one batch of D + 1 sets
+    per gradient); the walkers spread about it by each coordinate's own curvature there."""
+    from scipy.optimize import differential_evolution, minimize
 
     d = model.ndim
-    scan = np.column_stack([p.sample(rng, SCAN) for p in model.priors])
-    values = np.concatenate([log_prob(scan[i : i + BLOCK]) for i in range(0, SCAN, BLOCK)])
 
     def to_theta(u):
         u = np.clip(np.atleast_2d(u), 1e-12, 1 - 1e-12)
         return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
+
+    def negative(columns):  # (D, S) -> (S,), as scipy's vectorized search calls it
+        theta = to_theta(np.asarray(columns).T)
+        values = np.concatenate([log_prob(theta[i : i + BLOCK]) for i in range(0, len(theta), BLOCK)])
+        return np.where(np.isfinite(values), -values, 1e300)
+
+    found = differential_evolution(negative, [(0.0, 1.0)] * d, vectorized=True, updating="deferred", popsize=15,
+                                   maxiter=GENERATIONS, tol=1e-8, polish=False, seed=int(rng.integers(2**32)))
 
     def objective(u):
         # forward differences away from the cube's nearer face: D + 1 sets per call (a model call costs their square)
@@ -170,13 +176,9 @@ def _start(model: LightCurveModel, log_prob, rng: np.random.Generator, walkers: 
         grad = np.where(np.isfinite(v[1:]), (v[1:] - v[0]) / h, 0.0)
         return -float(v[0]), -grad
 
-    best_value, best_u = -np.inf, None
-    for i in np.argsort(-values)[:STARTS]:
-        u0 = np.array([float(p.cdf(scan[i, j])) for j, p in enumerate(model.priors)])
-        found = minimize(objective, np.clip(u0, 1e-9, 1 - 1e-9), jac=True, method="L-BFGS-B",
-                         bounds=[(1e-9, 1 - 1e-9)] * d, options={"maxiter": 500})
-        if -found.fun > best_value:
-            best_value, best_u = -found.fun, found.x
+    polished = minimize(objective, np.clip(found.x, 1e-9, 1 - 1e-9), jac=True, method="L-BFGS-B",
+                        bounds=[(1e-9, 1 - 1e-9)] * d, options={"maxiter": 500})
+    best_u = polished.x if polished.fun <= found.fun else found.x
     # each coordinate's step to a drop of 1/2 in log posterior (its conditional SD), from a second difference
     h = 1e-4
     rows = np.repeat(best_u[None, :], 2 * d + 1, axis=0)
@@ -258,7 +260,6 @@ class LightCurveInversion:
 
     def to_json(self) -> dict:
         """lightcurve.json's content (DESIGN.md), with each candidate's parameters and diagnostics added."""
-        from ..orbit.attitude import ANGLES
 
         best = self.best.summary()
         return {"ranking": self.ranking, "best": self.best.material,

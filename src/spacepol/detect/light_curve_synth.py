@@ -1,20 +1,9 @@
 """A measured light curve as a micro-polarizer camera would give it: the target's Stokes flux over a pass
 (``target.target_light``: its faces and their fixed materials) through aperture photometry on the four analyser
-channels, with the noise of the target's and the sky's photons, dark current and read noise, each time step the mean of a
-number of frames (a camera running through the step averages step / exposure of them).
+channels, with the noise of the target's and the sky's photons, dark current and read noise, each time step the mean
+of the frames that fill it; DoLP and AoP with delta-method errors.
 
-The target's image is the camera's PSF (a Gaussian of FWHM ``psf_fwhm_pixels``), summed over a circular aperture of
-radius one FWHM (pixels n = pi FWHM^2, enclosing 1 - 2^-4 of the light); a quarter of its pixels sit behind each
-analyser at 0, 45, 90 and 135 deg. The sky under the aperture is subtracted as known (estimated from many pixels
-around it): it adds only its photon noise. With K = A tau QE t EE / 8 (aperture A, transmittance tau, quantum
-efficiency QE, exposure t, enclosed energy EE), channel c collects
-
-    I_c = K (S0 + S1 cos 2a_c + S2 sin 2a_c)   electrons, variance I_c + sky_c + n/4 (RN^2 + dark t)
-
-and the estimates are S0 = sum I_c / 4K, S1 = (I_0 - I_90) / 2K, S2 = (I_45 - I_135) / 2K, each channel drawn from a
-normal distribution of that variance (its counts are hundreds and more). DoLP = |S1, S2| / S0 and AoP = atan2(S2,
-S1) / 2 in the observer's sky basis; their errors by the delta method at the measured values. Ideal analysers: the
-extinction ratio and saturation are left out (the pass's exposure keeps the sky at half the well).
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -1,19 +1,8 @@
-"""Named spacecraft surface materials for light-curve inversion: each a model of the effect library with physical
-priors at the camera's band.
+"""Named spacecraft surface materials for light-curve inversion (``aluminium``, ``kapton``, ``white_paint``,
+``solar_glass``): each ``specular+smith+lambertian`` with physical priors at the camera's band (indices from
+``data/nk`` where tabulated).
 
-All four are ``specular+smith+lambertian``: a Torrance-Sparrow facet lobe with exact Fresnel Mueller matrices and
-Smith shadowing (index n, extinction k, facet slope sigma, specular share ks) plus an unpolarized Lambertian body
-(albedo rho_l). What tells them apart is the index and the balance of polarizing specular to depolarizing diffuse
-light:
-
-- ``aluminium``: bare metal (n + ik of Rakic 1995 at the band's centre, ``data/nk``, within 15 %), mostly
-  specular (ks 0.6-1), little diffuse light (rho_l < 0.3); a metal's high k keeps its reflection weakly polarized.
-- ``kapton``: the polyimide film of multi-layer insulation (n of French et al. 2011, at most 1.59 um, the table's
-  end; k < 0.05 in the near infrared), glossy (ks 0.3-1), a diffuse share up to 0.5 (the film's wrinkles).
-- ``white_paint``: a dielectric binder (n 1.45-1.6, k 0) over a scattering pigment: weak specular (ks < 0.3),
-  bright diffuse (rho_l 0.5-0.95), as white thermal-control paints (e.g. AZ-93, S13G) in the near infrared.
-- ``solar_glass``: a cell's cover glass (fused silica or ceria-doped borosilicate, n 1.42-1.55, k 0), smooth
-  (sigma < 0.1), almost all specular, the dark cell under it (rho_l < 0.1): the strongest polarizer of the four.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

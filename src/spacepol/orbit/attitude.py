@@ -1,14 +1,8 @@
-"""A satellite's attitude as offsets from its nominal orientation: yaw, pitch and roll (degrees) about the orbit
-frame's axes, applied to the faces that turn with the body.
+"""A satellite's attitude as offsets from its nominal orientation: yaw, pitch and roll (degrees), the z-y-x
+sequence about the orbit frame's axes (x along the velocity, z towards the Earth's centre), R = Rz Ry Rx, turning the
+faces that turn with the body (``orientation = "nadir"``).
 
-The orbit frame is the nadir-pointing body's (``pass_geometry.Face``): x along the velocity, y across the orbit, z
-towards the Earth's centre. The offsets are the aerospace z-y-x sequence: a face's body-frame normal n is seen in
-the orbit frame as R n with
-
-    R = Rz(yaw) Ry(pitch) Rx(roll)
-
-(each a right-handed rotation about the orbit frame's own axis). Faces with ``orientation = "nadir"`` turn with the
-body; a sun-tracking panel keeps tracking the sun and an ``inertial`` face stays fixed in GCRS, whatever the offsets.
+The reasoning behind it, and what was measured: the internals page of the documentation (``docs/internals.md``).
 """
 
 from __future__ import annotations

@@ -172,6 +172,16 @@ def _criticism_commands(sub) -> None:
     p.add_argument("--out", default="reports/batch")
 
 
+def _pass_arguments(p) -> None:
+    """A satellite's pass: its elements, the site and the time window (observe, synth-pass, lightcurve)."""
+    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
+    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
+    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
+    p.add_argument("--start", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2014-01-21T00:33Z")
+    p.add_argument("--end", required=True, metavar="ISO8601")
+    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between times")
+
+
 def _sky_commands(sub) -> None:
     """sky, contrast, observe, frame: from a posterior to the sky and a camera."""
     p = sub.add_parser("sky", help="the sun (astropy) and the sky's polarization at a site and time; maps")
@@ -198,12 +208,7 @@ def _sky_commands(sub) -> None:
     p.add_argument("--out", default=None, help="default: RUN_DIR/contrast")
     p = sub.add_parser("observe", help="a satellite's pass: light curves and P_d(t) per detector from a run's posterior")
     p.add_argument("run_dir", metavar="RUN_DIR", help="the --out folder of `invert-mcmc run` (the target's material)")
-    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
-    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
-    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
-    p.add_argument("--start", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2014-01-21T00:33Z")
-    p.add_argument("--end", required=True, metavar="ISO8601")
-    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between times")
+    _pass_arguments(p)
     p.add_argument("--target", default=None, metavar="FILE.toml", help="[[faces]] (default: a 1 m cube and a 4 m^2 panel)")
     p.add_argument("--camera", default=None, metavar="FILE.toml", help="[camera] (default: an IMX250MZR-class sensor)")
     p.add_argument("--draws", type=_int_at_least(1), default=200, help="posterior draws of the material")
@@ -214,12 +219,7 @@ def _sky_commands(sub) -> None:
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: RUN_DIR/observe")
     p = sub.add_parser("synth-pass", help="a simulated measured light curve (flux, DoLP, AoP) of a target over a pass")
-    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
-    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
-    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
-    p.add_argument("--start", required=True, metavar="ISO8601", help="with UTC offset, e.g. 2014-01-21T00:33Z")
-    p.add_argument("--end", required=True, metavar="ISO8601")
-    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between times")
+    _pass_arguments(p)
     p.add_argument("--target", required=True, metavar="FILE.toml",
                    help="[[faces]], each with its material table; an optional attitude = {yaw_deg, pitch_deg, roll_deg}")
     p.add_argument("--camera", default=None, metavar="FILE.toml", help="[camera] (default: an IMX250MZR-class sensor)")
@@ -232,12 +232,7 @@ def _sky_commands(sub) -> None:
     p.set_defaults(command="synth_pass")
     p = sub.add_parser("lightcurve", help="a satellite's material and attitude from its measured light curve")
     p.add_argument("curve", metavar="FILE.csv", help="time_utc and any of flux, dolp, aop_deg with their _err columns")
-    p.add_argument("--tle", required=True, metavar="FILE", help="two- or three-line element sets (e.g. data/tle/)")
-    p.add_argument("--satellite", default=None, metavar="NAME", help="which satellite of the file (name or number)")
-    p.add_argument("--site", required=True, metavar="LAT,LON[,HEIGHT_M]")
-    p.add_argument("--start", required=True, metavar="ISO8601", help="the pass window's start, with UTC offset")
-    p.add_argument("--end", required=True, metavar="ISO8601")
-    p.add_argument("--step", type=_finite(0.0), default=10.0, metavar="S", help="seconds between the window's times")
+    _pass_arguments(p)
     p.add_argument("--target", required=True, metavar="FILE.toml",
                    help="[[faces]]: those without a material table are of the unknown material; an optional attitude "
                         "table fixes the offsets (inferred where absent)")

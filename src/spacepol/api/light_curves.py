@@ -185,6 +185,6 @@ def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um,
          f"{ATTITUDE_LIMIT_DEG:g} deg of the nominal orientation (z-y-x about the orbit frame)."),
         f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um; fitted: {', '.join(observables)}, each "
         "Gaussian with the file's errors (AoP on its 180-deg circle).",
-        f"Posterior: emcee, {steps} steps (the second half kept), walkers started about the best local optimum of a "
-        "prior scan; ELPD-LOO by PSIS over the measured points.",
+        f"Posterior: emcee, {steps} steps (the second half kept), walkers started about the global optimum of a "
+        "differential-evolution search (its mode only); ELPD-LOO by PSIS over the measured points.",
     ]

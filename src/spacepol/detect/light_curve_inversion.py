@@ -2,9 +2,9 @@
 material's parameters and the attitude offsets (emcee), ranked by ELPD-LOO (PSIS over the light curve's points).
 
 The likelihood: each measured point (flux, DoLP, AoP at a time) is Gaussian about the model's value with the
-file's 1-sigma error; an AoP residual is taken on its 180-deg circle. The walkers start from the best of a scan of
-the prior (``SCAN`` draws), so that they begin where the light curve is matched rather than at one guess; emcee's
-differential-evolution moves carry them between the attitude's separated solutions.
+file's 1-sigma error; an AoP residual is taken on its 180-deg circle. The posterior is narrow and its optima many (a
+box's faces alike under a turn; a narrow glint of smooth facets against a broad one of rough facets): the walkers
+start about the global optimum of a differential-evolution search (``_start``) and explore that optimum's mode only.
 """
 
 from __future__ import annotations

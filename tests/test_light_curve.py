@@ -57,6 +57,21 @@ def test_an_attitude_turns_the_body_faces_only():
     assert out[1] == faces[1] and out[2] == faces[2]
 
 
+def test_a_target_files_attitude_turns_its_faces_as_observe_and_synth_pass_read_them(tmp_path):
+    """``target_faces`` (what observe and synth-pass read): the file's attitude turns each nadir face's normal by its
+    rotation; a file without one is read as written."""
+    from spacepol.orbit import target_faces
+
+    turned_file = target_file(tmp_path, "attitude = {yaw_deg = 30.0, pitch_deg = 10.0, roll_deg = -5.0}")
+    faces = target_faces(turned_file)
+    rotation = Rotation.from_euler("ZYX", [30.0, 10.0, -5.0], degrees=True).as_matrix()
+    for face, plain in zip(faces, faces_from_toml(turned_file)):
+        np.testing.assert_allclose(face.normal, rotation @ np.asarray(plain.normal, float), atol=1e-14)
+    (tmp_path / "plain").mkdir()
+    plain_file = target_file(tmp_path / "plain")
+    assert target_faces(plain_file) == faces_from_toml(plain_file)
+
+
 @pytest.mark.parametrize("table, words", [
     ({"yaw": 3.0}, "attitude has no key yaw"),
     ({"yaw_deg": "ten"}, "yaw_deg = 'ten'"),

@@ -31,7 +31,7 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
     from ..detect.observation import auto_exposure_s
     from ..detect.target import fixed_material
     from ..io.light_curve import write_light_curve
-    from ..orbit import attitude_from_toml, faces_from_toml, pass_geometry, read_tle, turned
+    from ..orbit import pass_geometry, read_tle, target_faces
     from ..orbit.pass_geometry import time_steps
 
     if out is not None:
@@ -44,16 +44,13 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
     time_steps(start, end, step_s)
     if exposures_per_step is not None and not (isinstance(exposures_per_step, int) and exposures_per_step >= 1):
         raise ParameterError(f"--exposures {exposures_per_step}: need a whole number of at least 1")
-    faces = faces_from_toml(target)
-    attitude = attitude_from_toml(target)
+    faces = target_faces(target)  # turned by the file's attitude offsets, where it has them
     bare = [f.name for f in faces if f.material is None]
     if bare:
         raise ParameterError(f"--target {target}: face {', '.join(bare)} has no material; synth-pass renders faces of "
                              "known materials (give each a material = {model = \"...\", ...} table)")
     for face in faces:
         fixed_material(face.material)
-    if attitude is not None:
-        faces = turned(faces, attitude)
     cam = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
     geometry = pass_geometry(read_tle(tle, satellite), site, start, end, step_s, faces)
     if not cam.exposure_set:

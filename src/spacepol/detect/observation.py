@@ -213,12 +213,13 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     from pathlib import Path
 
     from ..camera.sensor import Camera, camera_from_toml
-    from ..orbit import default_faces, faces_from_toml, pass_geometry, read_tle
+    from ..orbit import default_faces, pass_geometry, read_tle, target_faces
     from .contrast import material_samples
     from .scenario import default_scenario
 
     rng = np.random.default_rng(0) if rng is None else rng
-    faces = default_faces() if target is None else faces_from_toml(target) if isinstance(target, (str, Path)) else list(target)
+    # a target file's attitude offsets turn its body faces, as they fly
+    faces = default_faces() if target is None else target_faces(target) if isinstance(target, (str, Path)) else list(target)
     camera = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
     for face in faces:  # a face's own material is checked before the pass is computed
         if face.material is not None:

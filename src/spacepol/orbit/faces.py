@@ -9,7 +9,7 @@ import tomllib
 from pathlib import Path
 
 from ..errors import ParameterError
-from .attitude import Attitude, attitude_from_table
+from .attitude import Attitude, attitude_from_table, turned
 from .pass_geometry import Face
 
 FACE_KEYS = {"name", "area_m2", "orientation", "normal", "material"}
@@ -66,3 +66,10 @@ def faces_from_toml(path) -> list[Face]:
     if len(set(names)) != len(names):
         raise ParameterError(f"--target {path}: two faces share a name ({', '.join(sorted({n for n in names if names.count(n) > 1}))})")
     return faces
+
+
+def target_faces(path) -> list[Face]:
+    """The faces of a target TOML file as they fly: turned by the file's top-level ``attitude`` offsets where it has
+    them (``attitude.turned``), as written where it has none."""
+    faces, attitude = faces_from_toml(path), attitude_from_toml(path)
+    return faces if attitude is None else turned(faces, attitude)

@@ -49,9 +49,7 @@ def limit_contact(shape: list) -> dict:
     """The phase matrix of box coordinates ``shape`` against K: nodes' gauge, spline gauge, control points within
     1e-4 of the largest gauge (index, angle in deg, gauge)."""
     nodes = constrained_phase.node_values(shape)
-    points = [np.tensordot(constrained_phase.CONTROL_POINTS, np.stack(np.broadcast_arrays(*v)), axes=1)
-              for v in nodes.elements()]
-    gauges = np.asarray(constrained_phase.gauge(*points), float)
+    gauges = np.asarray(constrained_phase.control_point_gauges(nodes), float)
     top = gauges.max()
     near = [(int(j), control_point_angle_deg(int(j)), float(gauges[j])) for j in np.flatnonzero(gauges > top - 1e-4)]
     return {"nodes_gauge": float(constrained_phase.nodes_gauge(nodes)), "spline_gauge": float(top), "at_limit": near}

@@ -24,11 +24,8 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
     sky where not given), the noise drawn with ``seed``, each time the mean of ``exposures_per_step`` frames (default:
     as many as fill the step, a camera running through it). Only the times when the satellite is above the horizon,
     sunlit and turning a lit face to the site are kept. With ``out`` the CSV (``io.light_curve``) is written there."""
-    from dataclasses import replace
-
-    from ..camera.sensor import Camera, camera_from_toml
     from ..detect.light_curve_synth import synthesized_light_curve
-    from ..detect.observation import auto_exposure_s
+    from ..detect.observation import camera_given, exposed_for
     from ..detect.target import fixed_material
     from ..io.light_curve import write_light_curve
     from ..orbit import pass_geometry, read_tle, target_faces
@@ -39,9 +36,7 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
 
         out = check_output_file(out)
     site = parse_site(site)
-    if not (np.isfinite(step_s) and step_s > 0):
-        raise ParameterError(f"--step {step_s}: need a number of seconds > 0")
-    time_steps(start, end, step_s)
+    time_steps(start, end, step_s)  # the window and its step, checked before any work
     if exposures_per_step is not None and not (isinstance(exposures_per_step, int) and exposures_per_step >= 1):
         raise ParameterError(f"--exposures {exposures_per_step}: need a whole number of at least 1")
     faces = target_faces(target)  # turned by the file's attitude offsets, where it has them
@@ -51,10 +46,9 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
                              "known materials (give each a material = {model = \"...\", ...} table)")
     for face in faces:
         fixed_material(face.material)
-    cam = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+    cam = camera_given(camera)
     geometry = pass_geometry(read_tle(tle, satellite), site, start, end, step_s, faces)
-    if not cam.exposure_set:
-        cam = replace(cam, exposure_s=auto_exposure_s(cam, geometry, sky_magnitude_zenith), exposure_set=True)
+    cam = exposed_for(cam, geometry, sky_magnitude_zenith)
     frames = exposures_per_step or max(1, int(step_s // cam.exposure_s))
     curve = synthesized_light_curve(geometry, cam, np.random.default_rng(seed), band_um, sky_magnitude_zenith, frames)
     if out is not None:
@@ -75,7 +69,7 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
     light_curve.png, attitude_corner.png and report.html."""
     from ..detect.light_curve_inversion import LightCurveInversion, MaterialFit, check_observables, fit_material
     from ..detect.light_curve_model import LightCurveModel
-    from ..orbit import attitude_from_toml, faces_from_toml
+    from ..orbit import read_target
 
     if out is not None:
         from ..io.output import check_output_dir
@@ -87,7 +81,7 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
     candidates = _candidates(materials, band_um)  # an unknown name: one line, before any work
     curve = _curve_in_window(curve, start, end, step_s)
     observables = check_observables(curve, observables)
-    faces, attitude = faces_from_toml(target), attitude_from_toml(target)
+    faces, attitude = read_target(target)
     geometry, element_set = _visible_geometry(curve, tle, satellite, site, faces)
     rng = np.random.default_rng(seed)
     key = _run_key(curve, tle, satellite, site, target, observables, steps, seed, band_um)

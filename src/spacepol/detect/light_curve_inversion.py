@@ -20,8 +20,10 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..infer.diagnostics import loo
+from ..io.light_curve import OBSERVABLES
 from ..orbit.attitude import ANGLES
 from .light_curve_model import LightCurveModel
+from .target import linear_polarization
 
 GENERATIONS = 300  # at most, of the differential-evolution search that places the walkers
 DRAWS_FOR_LOO = 2000
@@ -30,14 +32,14 @@ BLOCK = 16  # sets per model evaluation (its cost grows as the square of the set
 
 def predicted(model: LightCurveModel, theta: np.ndarray) -> dict[str, np.ndarray]:
     """{flux, dolp, aop_deg: (S, T)} the model's values for rows ``theta`` (NaN DoLP and AoP where no light)."""
-    out = {"flux": [], "dolp": [], "aop_deg": []}
-    for i in range(0, len(theta), BLOCK):
-        s0, s1, s2 = model.stokes(theta[i : i + BLOCK])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out["flux"].append(s0)
-            out["dolp"].append(np.where(s0 > 0, np.hypot(s1, s2) / s0, np.nan))
-            out["aop_deg"].append(np.where(s0 > 0, 0.5 * np.degrees(np.arctan2(s2, s1)), np.nan))
-    return {k: np.concatenate(v) for k, v in out.items()}
+    s0, s1, s2 = np.concatenate([model.stokes(theta[i : i + BLOCK]) for i in range(0, len(theta), BLOCK)], axis=1)
+    dolp, aop = linear_polarization(s0, s1, s2)
+    return {"flux": s0, "dolp": dolp, "aop_deg": aop}
+
+
+def _wrapped_aop(difference):
+    """An AoP difference (deg) on its 180-deg circle, in [-90, 90)."""
+    return (difference + 90.0) % 180.0 - 90.0
 
 
 def pointwise_log_likelihood(model: LightCurveModel, curve, observables: list[str], theta: np.ndarray) -> np.ndarray:
@@ -45,10 +47,10 @@ def pointwise_log_likelihood(model: LightCurveModel, curve, observables: list[st
     mu = predicted(model, theta)
     parts = []
     for name in observables:
-        measured, error = getattr(curve, name), getattr(curve, {"flux": "flux_err", "dolp": "dolp_err", "aop_deg": "aop_err_deg"}[name])
+        measured, error = getattr(curve, name), getattr(curve, OBSERVABLES[name])
         residual = measured - np.nan_to_num(mu[name])  # no light predicted: a model of 0 flux, DoLP and AoP
         if name == "aop_deg":
-            residual = (residual + 90.0) % 180.0 - 90.0
+            residual = _wrapped_aop(residual)
         parts.append(-0.5 * (residual / error) ** 2 - np.log(error * np.sqrt(2 * np.pi)))
     return np.concatenate(parts, axis=1)
 
@@ -195,14 +197,13 @@ def _start(model: LightCurveModel, log_prob, rng: np.random.Generator, walkers: 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:
     """{observable: (3, T)} the 5/50/95 % of the posterior predictive (the model plus the file's noise)."""
-    mu = predicted(model, draws)
-    errors = {"flux": curve.flux_err, "dolp": curve.dolp_err, "aop_deg": curve.aop_err_deg}
     out = {}
-    for name, values in mu.items():
-        noise = 0.0 if errors[name] is None else errors[name] * rng.standard_normal(values.shape)
+    for name, values in predicted(model, draws).items():
+        error = getattr(curve, OBSERVABLES[name])
+        noise = 0.0 if error is None else error * rng.standard_normal(values.shape)
         replicated = np.nan_to_num(values) + noise
         if name == "aop_deg":
-            replicated = (replicated + 90.0) % 180.0 - 90.0
+            replicated = _wrapped_aop(replicated)
         out[name] = np.percentile(replicated, [5, 50, 95], axis=0)
     return out
 

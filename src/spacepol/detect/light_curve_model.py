@@ -21,7 +21,7 @@ from ..orbit.pass_geometry import face_angles, orbit_axes
 from ..physics.geometry import Geometry
 from ..priors import Prior, Uniform
 from .materials import Material
-from .target import fixed_material, rotation_to_sky, sky_basis, solar_band
+from .target import by_material, fixed_material, rotation_to_sky, sky_basis, solar_band
 
 ATTITUDE_LIMIT_DEG = 60.0  # the attitude offsets' prior: uniform within this many degrees of the nominal orientation
 _VIEW_LIMIT_DEG = 89.9  # a face seen or lit more obliquely sends no light; the model is evaluated at most here
@@ -111,18 +111,13 @@ class LightCurveModel:
 
     def _brdf(self, theta: np.ndarray, angles: tuple, n_sets: int) -> np.ndarray:
         """(3, F * S * T) each face's Stokes BRDF at its rows' ``angles`` (theta_i, theta_r, dphi in degrees): the
-        unknown material's faces at each set's own
-        parameters (one evaluation of the S sets at all their rows, its diagonal blocks kept), each fixed material's
-        faces in one evaluation of its own."""
+        unknown material's faces at each set's own parameters (one evaluation of the S sets at all their rows, its
+        diagonal blocks kept), each fixed material's faces in one evaluation of its own."""
         g = self.geometry
         per_face = len(angles[0]) // len(g.faces)
         out = np.zeros((3, len(angles[0])))
         material = self._held | {n: theta[:, j] for j, n in enumerate(self.names) if n not in ANGLES}
-        groups: dict = {}
-        for k, face in enumerate(g.faces):
-            key = None if face.material is None else tuple(sorted(face.material.items()))
-            groups.setdefault(key, []).append(k)
-        for key, faces in groups.items():
+        for key, faces in by_material(g.faces, np.arange(len(g.faces))).items():
             index = np.concatenate([np.arange(k * per_face, (k + 1) * per_face) for k in faces])
             sub = Geometry(*(a[index] for a in angles))
             if key is not None:

@@ -191,6 +191,28 @@ def auto_exposure_s(camera, geometry, sky_magnitude_zenith: float = 5.40, fill: 
     return float(max(step * decade for step in (1.0, 2.0, 5.0) if step * decade <= seconds))
 
 
+def camera_given(camera):
+    """The camera a pass is seen with: a TOML file's [camera], a ``camera.sensor.Camera`` as it is, or the default
+    (None) with its exposure left for the pass to set (``exposed_for``)."""
+    from pathlib import Path
+
+    from ..camera.sensor import Camera, camera_from_toml
+
+    if camera is None:
+        return Camera(exposure_set=False)
+    return camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+
+
+def exposed_for(camera, geometry, sky_magnitude_zenith: float = 5.40):
+    """``camera`` as it is where its exposure was given; else with the exposure that keeps the brightest sky of the
+    pass at half the well (``auto_exposure_s``)."""
+    from dataclasses import replace
+
+    if camera.exposure_set:
+        return camera
+    return replace(camera, exposure_s=auto_exposure_s(camera, geometry, sky_magnitude_zenith), exposure_set=True)
+
+
 def _sky_aop(geometry) -> np.ndarray:
     """The sky's AoP (deg) at the target's direction in the target's sky basis (``target.sky_basis``): single
     scattering's E-vector, perpendicular to the sun - view plane."""
@@ -209,10 +231,8 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     the default cube with a panel), seen by ``camera`` (a TOML file, a ``Camera``, or the default, its exposure set
     from the pass where not given), under a sky of ``sky_magnitude_zenith`` mag arcsec^-2 at the zenith polarized up
     to ``p_max``. Returns the Observation and the report's sentences on what it assumed."""
-    from dataclasses import replace
     from pathlib import Path
 
-    from ..camera.sensor import Camera, camera_from_toml
     from ..orbit import default_faces, pass_geometry, read_tle, target_faces
     from .contrast import material_samples
     from .scenario import default_scenario
@@ -220,14 +240,13 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
     rng = np.random.default_rng(0) if rng is None else rng
     # a target file's attitude offsets turn its body faces, as they fly
     faces = default_faces() if target is None else target_faces(target) if isinstance(target, (str, Path)) else list(target)
-    camera = Camera(exposure_set=False) if camera is None else camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
+    camera = camera_given(camera)
     for face in faces:  # a face's own material is checked before the pass is computed
         if face.material is not None:
             fixed_material(face.material)
     element_set = read_tle(tle, satellite)
     geometry = pass_geometry(element_set, site, start, end, step_s, faces)
-    if not camera.exposure_set:  # no exposure given: the one that keeps the brightest sky of the pass at half the well
-        camera = replace(camera, exposure_s=auto_exposure_s(camera, geometry), exposure_set=True)
+    camera = exposed_for(camera, geometry)
     scenario = default_scenario()
     scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
     inner, params, material = material_samples(result.model, result.samples(), scenario,

@@ -100,7 +100,7 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         g = Geometry(geometry.theta_i_deg[times, faces], geometry.theta_r_deg[times, faces], geometry.dphi_deg[times, faces])
         sr = np.zeros((4, n_draws, times.size))
         # every (time, face) of one material in one evaluation of its model: the run's, or a face's fixed one
-        for material, rows in _by_material(geometry.faces, faces).items():
+        for material, rows in by_material(geometry.faces, faces).items():
             face_model, face_params = (model, params) if material is None else fixed_material(material)
             sub = Geometry(g.theta_i[rows], g.theta_r[rows], g.dphi[rows])
             sr[:, :, rows] = np.asarray(face_model.evaluate(face_params, sub).stokes, float).reshape(4, -1, rows.size)
@@ -113,14 +113,20 @@ def target_light(geometry, model, draws: dict, band_um: tuple[float, float], irr
         rotated = np.stack([sr[0], c * sr[1] + sn * sr[2], -sn * sr[1] + c * sr[2], sr[3]]) * scale
         for component in range(4):  # faces seen at the same time add up
             np.add.at(stokes[component], (slice(None), times), np.broadcast_to(rotated[component], (n_draws, times.size)))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lit = stokes[0] > 0
-        dolp = np.where(lit, np.hypot(stokes[1], stokes[2]) / np.where(lit, stokes[0], 1.0), np.nan)
-        aop = np.where(lit, 0.5 * np.degrees(np.arctan2(stokes[2], stokes[1])), np.nan)
+    dolp, aop = linear_polarization(*stokes[:3])
     return TargetLight(stokes, stokes[0] * photons / irradiance, dolp, aop, lit_faces, photons / irradiance)
 
 
-def _by_material(faces, face_index: np.ndarray) -> dict:
+def linear_polarization(s0, s1, s2) -> tuple[np.ndarray, np.ndarray]:
+    """(DoLP, AoP in degrees) of linear Stokes components (any shape), NaN where no light comes (S0 <= 0)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit = s0 > 0
+        dolp = np.where(lit, np.hypot(s1, s2) / np.where(lit, s0, 1.0), np.nan)
+        aop = np.where(lit, 0.5 * np.degrees(np.arctan2(s2, s1)), np.nan)
+    return dolp, aop
+
+
+def by_material(faces, face_index: np.ndarray) -> dict:
     """{material key (None: the run's; else the fixed material's items): rows of ``face_index`` made of it}."""
     keys = [None if f.material is None else tuple(sorted(f.material.items())) for f in faces]
     groups: dict = {}

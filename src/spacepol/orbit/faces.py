@@ -32,18 +32,23 @@ def _read(path: Path) -> dict:
         raise ParameterError(f"--target {path}: not valid TOML ({exc})") from None
 
 
-def attitude_from_toml(path) -> Attitude | None:
-    """The target file's top-level ``attitude = {yaw_deg, pitch_deg, roll_deg}`` offsets, None where it has none."""
+def read_target(path) -> tuple[list[Face], Attitude | None]:
+    """(the ``[[faces]]`` of a target TOML file, its top-level ``attitude = {yaw_deg, pitch_deg, roll_deg}`` offsets
+    or None where it has none), the file read once; a bad table is one line naming the file."""
     path = Path(path)
-    table = _read(path).get("attitude")
-    return None if table is None else attitude_from_table(table, f"--target {path}")
+    content = _read(path)
+    table = content.get("attitude")
+    return _faces(path, content.get("faces")), None if table is None else attitude_from_table(table, f"--target {path}")
 
 
 def faces_from_toml(path) -> list[Face]:
-    """The ``[[faces]]`` of a target TOML file; an unknown key, a missing area or a bad value is one line naming the
-    face."""
-    path = Path(path)
-    tables = _read(path).get("faces")
+    """The ``[[faces]]`` of a target TOML file (``read_target``'s faces)."""
+    return read_target(path)[0]
+
+
+def _faces(path: Path, tables) -> list[Face]:
+    """The faces of a file's ``[[faces]]`` tables; an unknown key, a missing area or a bad value is one line naming
+    the face."""
     if not isinstance(tables, list) or not tables:
         raise ParameterError(f"--target {path}: no [[faces]] tables (each with name, area_m2, orientation, normal)")
     faces = []
@@ -71,5 +76,5 @@ def faces_from_toml(path) -> list[Face]:
 def target_faces(path) -> list[Face]:
     """The faces of a target TOML file as they fly: turned by the file's top-level ``attitude`` offsets where it has
     them (``attitude.turned``), as written where it has none."""
-    faces, attitude = faces_from_toml(path), attitude_from_toml(path)
+    faces, attitude = read_target(path)
     return faces if attitude is None else turned(faces, attitude)

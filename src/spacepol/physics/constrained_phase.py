@@ -158,12 +158,17 @@ def nodes_gauge(nodes: NodeValues):
     return reduce(jnp.maximum, values)
 
 
-def spline_gauge(nodes: NodeValues):
-    """The largest gauge over the spline's Bezier control points: <= 1 means realizable at every angle. All control
-    points at once, as one (points x nodes) product per element (a loop over them traced ~2,500 operations)."""
+def control_point_gauges(nodes: NodeValues):
+    """The gauge of each of the spline's Bezier control points (``CONTROL_POINTS``' rows), all at once as one
+    (points x nodes) product per element (a loop over them traced ~2,500 operations)."""
     points = [jnp.tensordot(CONTROL_POINTS, jnp.stack(jnp.broadcast_arrays(*values)), axes=1)
               for values in nodes.elements()]
-    return jnp.max(gauge(*points), axis=0)
+    return gauge(*points)
+
+
+def spline_gauge(nodes: NodeValues):
+    """The largest gauge over the spline's Bezier control points: <= 1 means realizable at every angle."""
+    return jnp.max(control_point_gauges(nodes), axis=0)
 
 
 

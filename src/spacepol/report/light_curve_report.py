@@ -10,10 +10,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..io.atomic import atomic_path, save_figure, write_json
+from ..io.light_curve import OBSERVABLES
 from ..orbit.attitude import ANGLES
 from . import html as H
 
-_PANELS = (("flux", "flux_err", "photons m^-2 s^-1"), ("dolp", "dolp_err", "DoLP"), ("aop_deg", "aop_err_deg", "AoP (deg)"))
+_LABELS = {"flux": "photons m^-2 s^-1", "dolp": "DoLP", "aop_deg": "AoP (deg)"}
 
 
 def light_curve_figure(inversion, fig=None) -> Figure:
@@ -23,7 +24,7 @@ def light_curve_figure(inversion, fig=None) -> Figure:
     minutes = np.array([(t - curve.times_utc[0]).total_seconds() / 60.0 for t in curve.times_utc])
     fig = fig or Figure(figsize=(8.0, 8.0), layout="constrained")
     axes = fig.subplots(3, 1, sharex=True)
-    for ax, (name, err, label) in zip(axes, _PANELS):
+    for ax, (name, err) in zip(axes, OBSERVABLES.items()):
         for k, f in enumerate(inversion.fits):
             low, median, high = f.bands[name]
             ax.fill_between(minutes, low, high, color=f"C{k + 1}", alpha=0.25, lw=0)
@@ -32,7 +33,7 @@ def light_curve_figure(inversion, fig=None) -> Figure:
             fitted = "fitted" if name in inversion.observables else "not fitted"
             ax.errorbar(minutes, getattr(curve, name), getattr(curve, err), fmt=".", color="k", ms=3, lw=0.8,
                         label=f"measured ({fitted})")
-        ax.set_ylabel(label)
+        ax.set_ylabel(_LABELS[name])
         ax.grid(alpha=0.3)
     axes[0].set_yscale("log")
     axes[0].legend(fontsize=7)

@@ -171,3 +171,17 @@ def test_synth_pass_writes_the_curve_and_bad_input_is_one_line_with_nothing_left
         run = run_cli("synth-pass", "--tle", TLE, *(a for item in options.items() for a in item), "--out", bad)
         assert run.returncode == 2 and words in run.stderr and len(run.stderr.strip().splitlines()) == 1, run.stderr
         assert not bad.exists()
+
+
+def test_a_written_target_reads_back_as_its_faces_and_attitude(tmp_path):
+    """write_target then read_target gives the same faces (materials included) and attitude; without an attitude
+    the file has none; the hand-written box of this module reads as the same faces the writer is given."""
+    from spacepol.orbit import read_target, write_target
+
+    faces = [Face("nadir", 3.0, "nadir", (0.0, 0.0, 1.0), {"model": "specular+smith", "n": 1.37, "k": 7.6}),
+             Face("panel", 4.0, "sun"), Face("star", 0.5, "inertial", (0.6, 0.0, 0.8))]
+    read, attitude = read_target(write_target(tmp_path / "t.toml", faces, Attitude(12.5, -3.0, 0.25)))
+    assert read == faces and attitude == Attitude(12.5, -3.0, 0.25)
+    assert read_target(write_target(tmp_path / "u.toml", faces))[1] is None
+    hand = faces_from_toml(target_file(tmp_path))
+    assert faces_from_toml(write_target(tmp_path / "v.toml", hand)) == hand

@@ -239,7 +239,7 @@ def _sky_commands(sub) -> None:
     p.add_argument("--materials", required=True, metavar="NAME,...",
                    help="candidate materials: aluminium, kapton, white_paint, solar_glass")
     p.add_argument("--observables", default=None, metavar="NAME,...", help="flux, dolp, aop (default: all the file holds)")
-    p.add_argument("--steps", type=_int_at_least(100), default=3000, help="emcee steps per material (the second half kept)")
+    p.add_argument("--live", type=_int_at_least(50), default=500, help="nested sampling's live points per material")
     p.add_argument("--seed", type=SEED, default=0)
     p.add_argument("--out", default=None, help="default: a folder named after the CSV, beside it")
     p = sub.add_parser("frame", help="a raw micro-polarizer frame (IMX250MZR mosaic) as Stokes, DoLP and AoP maps")

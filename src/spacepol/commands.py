@@ -336,7 +336,7 @@ def lightcurve(args) -> int:
     inversion = invert_lightcurve(args.curve, args.tle, args.site, args.start, args.end, target=args.target,
                                   materials=args.materials, step_s=args.step, satellite=args.satellite,
                                   observables=args.observables.split(",") if args.observables else None,
-                                  seed=args.seed, steps=args.steps, out=out, progress=True)
+                                  seed=args.seed, live=args.live, out=out, progress=True)
     for row in inversion.ranking:
         print(f"{row['material']:<12s} ELPD-LOO {row['elpd']:12.1f} +- {row['elpd_se']:.1f}   "
               f"delta {row['delta_elpd']:12.1f} +- {row['delta_elpd_se']:.1f}")

@@ -57,14 +57,14 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
 
 
 def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s: float = 10.0,
-                      observables=None, satellite: str | None = None, seed: int = 0, steps: int = 3000,
+                      observables=None, satellite: str | None = None, seed: int = 0, live: int = 500,
                       band_um=(1.5, 1.8), out=None, progress: bool = False):
     """A satellite's material and attitude from its light curve (``curve``: a LightCurve or its CSV file), measured
     from ``site`` in the window ``start``-``end`` (its times must lie inside it; ``step_s`` the window's grid, checked)
     of the satellite of ``tle``. ``target``: a TOML file of faces; those without a material table are made of the
     unknown material, and a top-level ``attitude`` table fixes the offsets (inferred, within 60 deg, where absent).
     For each name of ``materials`` (``detect.materials.LIBRARY``) the joint posterior of its parameters and the
-    offsets (emcee, ``steps``), ranked by ELPD-LOO over ``observables`` (flux, dolp, aop; default all the file
+    offsets and its evidence (nested sampling with ``live`` live points), ranked by ELPD-LOO over ``observables`` (flux, dolp, aop; default all the file
     holds). Returns the ``detect.light_curve_inversion.LightCurveInversion``; with ``out`` lightcurve.json,
     light_curve.png, attitude_corner.png and report.html."""
     from ..detect.light_curve_inversion import LightCurveInversion, MaterialFit, check_observables, fit_material
@@ -76,15 +76,15 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
 
         out = check_output_dir(Path(out))
     site = parse_site(site)
-    if not (isinstance(steps, int) and steps >= 100):
-        raise ParameterError(f"--steps {steps}: need a whole number of at least 100")
+    if not (isinstance(live, int) and live >= 50):
+        raise ParameterError(f"--live {live}: need a whole number of at least 50")
     candidates = _candidates(materials, band_um)  # an unknown name: one line, before any work
     curve = _curve_in_window(curve, start, end, step_s)
     observables = check_observables(curve, observables)
     faces, attitude = read_target(target)
     geometry, element_set = _visible_geometry(curve, tle, satellite, site, faces)
     rng = np.random.default_rng(seed)
-    key = _run_key(curve, tle, satellite, site, target, observables, steps, seed, band_um)
+    key = _run_key(curve, tle, satellite, site, target, observables, live, seed, band_um)
     fits = []
     for candidate in candidates:
         stream = rng.spawn(1)[0]  # drawn for every candidate, fitted or kept, so each gets the same stream
@@ -95,11 +95,11 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
         if progress:
             print(f"lightcurve: {candidate.name} ({candidate.description})", file=sys.stderr)
         model = LightCurveModel(geometry, candidate, attitude, band_um)
-        fits.append(fit_material(model, curve, observables, stream, steps=steps, progress=progress))
+        fits.append(fit_material(model, curve, observables, stream, live=live, progress=progress))
         if out is not None:  # an interrupted run keeps the materials it finished
             (out / "fits").mkdir(parents=True, exist_ok=True)
             fits[-1].save(out / "fits" / f"{candidate.name}.npz", key)
-    notes = _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, steps)
+    notes = _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, live)
     inversion = LightCurveInversion(curve, fits, observables, notes)
     if out is not None:
         from ..report.light_curve_report import write_light_curve_report
@@ -108,12 +108,12 @@ def invert_lightcurve(curve, tle, site, start, end, *, target, materials, step_s
     return inversion
 
 
-def _run_key(curve, tle, satellite, site, target, observables, steps, seed, band_um) -> str:
+def _run_key(curve, tle, satellite, site, target, observables, live, seed, band_um) -> str:
     """A digest of everything a material's fit depends on: a saved fit is reused only for the same inputs."""
     import hashlib
 
     parts = [curve.rows(), Path(tle).read_text(encoding="utf-8", errors="replace"), satellite, list(site),
-             Path(target).read_text(encoding="utf-8", errors="replace"), observables, steps, seed, list(band_um)]
+             Path(target).read_text(encoding="utf-8", errors="replace"), observables, live, seed, list(band_um)]
     return hashlib.sha256(repr(parts).encode()).hexdigest()
 
 
@@ -162,7 +162,7 @@ def _visible_geometry(curve, tle, satellite, site, faces):
     return geometry, element_set
 
 
-def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, steps) -> list[str]:
+def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um, observables, live) -> list[str]:
     from ..detect.light_curve_model import ATTITUDE_LIMIT_DEG
 
     unknown_faces = [f.name for f in faces if f.material is None]
@@ -176,6 +176,6 @@ def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um,
          f"{ATTITUDE_LIMIT_DEG:g} deg of the nominal orientation (z-y-x about the orbit frame)."),
         f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um; fitted: {', '.join(observables)}, each "
         "Gaussian with the file's errors (AoP on its 180-deg circle).",
-        f"Posterior: emcee, {steps} steps (the second half kept), walkers started about the global optimum of a "
-        "differential-evolution search (its mode only); ELPD-LOO by PSIS over the measured points.",
+        f"Posterior and evidence: nested sampling (nautilus, {live} live points) from the whole prior, every mode it "
+        "finds weighted by its mass; ELPD-LOO by PSIS over the measured points.",
     ]

@@ -1,10 +1,11 @@
 """A satellite's material and attitude from its light curve: for each candidate material the joint posterior of the
-material's parameters and the attitude offsets (emcee), ranked by ELPD-LOO (PSIS over the light curve's points).
+material's parameters and the attitude offsets and its evidence (nested sampling, nautilus), ranked by ELPD-LOO
+(PSIS over the light curve's points).
 
 The likelihood: each measured point (flux, DoLP, AoP at a time) is Gaussian about the model's value with the
 file's 1-sigma error; an AoP residual is taken on its 180-deg circle. The posterior is narrow and its optima many (a
-box's faces alike under a turn; a narrow glint of smooth facets against a broad one of rough facets): the walkers
-start about the global optimum of a differential-evolution search (``_start``) and explore that optimum's mode only.
+box's faces alike under a turn; a narrow glint of smooth facets against a broad one of rough facets): nested
+sampling shrinks from the whole prior, so it finds the modes a local sampler started at one optimum would miss.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ import time
 from dataclasses import dataclass
 
 import arviz as az
-import emcee
 import numpy as np
 
 from ..errors import ParameterError
@@ -25,7 +25,7 @@ from ..orbit.attitude import ANGLES
 from .light_curve_model import LightCurveModel
 from .target import linear_polarization
 
-GENERATIONS = 300  # at most, of the differential-evolution search that places the walkers
+EFFECTIVE_DRAWS = 2000  # nested sampling stops once its weighted points are worth this many independent draws
 DRAWS_FOR_LOO = 2000
 BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
 
@@ -57,18 +57,19 @@ def pointwise_log_likelihood(model: LightCurveModel, curve, observables: list[st
 
 @dataclass
 class MaterialFit:
-    """One candidate's posterior: ``names``, ``samples`` (draws, D), the ELPD-LOO record (``loo``: elpd_loo,
-    elpd_loo_se, p_loo, pareto_k, pointwise), emcee's ``rhat_max``, ``ess_min`` and ``acceptance``, the
-    posterior-predictive bands {observable: (3, T) 5/50/95 %}, and ``seconds``."""
+    """One candidate's posterior: ``names``, ``samples`` (equally weighted draws, D), the ELPD-LOO record (``loo``:
+    elpd_loo, elpd_loo_se, p_loo, pareto_k, pointwise), nested sampling's ``log_evidence`` (ln Z), its weighted
+    points' ``effective_draws`` and its ``likelihood_calls``, the posterior-predictive bands {observable: (3, T)
+    5/50/95 %}, and ``seconds``."""
 
     material: str
     description: str
     names: list[str]
     samples: np.ndarray
     loo: dict
-    rhat_max: float
-    ess_min: float
-    acceptance: float
+    log_evidence: float
+    effective_draws: float
+    likelihood_calls: int
     bands: dict
     seconds: float
 
@@ -77,7 +78,8 @@ class MaterialFit:
         from ..io.atomic import atomic_path
 
         scalars = {"material": self.material, "description": self.description, "names": self.names, "key": key,
-                   "rhat_max": self.rhat_max, "ess_min": self.ess_min, "acceptance": self.acceptance,
+                   "log_evidence": self.log_evidence, "effective_draws": self.effective_draws,
+                   "likelihood_calls": self.likelihood_calls,
                    "seconds": self.seconds, "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
         arrays = {"samples": self.samples, "pointwise": self.loo["pointwise"], "pareto_k": self.loo["pareto_k"]}
         arrays |= {f"band_{k}": v for k, v in self.bands.items()}
@@ -97,7 +99,7 @@ class MaterialFit:
                 bands = {k.removeprefix("band_"): f[k] for k in f.files if k.startswith("band_")}
                 record = scalars["loo"] | {"pointwise": f["pointwise"], "pareto_k": f["pareto_k"]}
                 return cls(scalars["material"], scalars["description"], scalars["names"], f["samples"], record,
-                           scalars["rhat_max"], scalars["ess_min"], scalars["acceptance"], bands, scalars["seconds"])
+                           scalars["log_evidence"], scalars["effective_draws"], scalars["likelihood_calls"], bands, scalars["seconds"])
         except (OSError, ValueError, KeyError, EOFError):
             return None
 
@@ -107,92 +109,47 @@ class MaterialFit:
         return {n: {"median": float(q[0, j]), "q05": float(q[1, j]), "q95": float(q[2, j])} for j, n in enumerate(self.names)}
 
 
-def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.random.Generator, steps: int = 3000,
-                 walkers: int | None = None, progress: bool = False) -> MaterialFit:
-    """``model``'s posterior given ``curve``'s ``observables`` (emcee, the second half of ``steps`` kept)."""
+def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.random.Generator, live: int = 500,
+                 progress: bool = False) -> MaterialFit:
+    """``model``'s posterior given ``curve``'s ``observables`` and its evidence ln Z: nested sampling (nautilus,
+    ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode."""
+    from nautilus import Sampler
+
+    from ..infer.engines.nested import replicate_draws
+
     start = time.perf_counter()
-    walkers = walkers or max(32, 4 * model.ndim)
-    walkers += walkers % 2
+    calls = {"sets": 0, "next": 20000}
 
-    def log_prob(theta):
+    def log_likelihood(theta):
         theta = np.atleast_2d(theta)
-        prior = model.log_prior(theta)
-        out = np.full(len(theta), -np.inf)
-        ok = np.isfinite(prior)
-        if ok.any():
-            out[ok] = prior[ok] + pointwise_log_likelihood(model, curve, observables, theta[ok]).sum(axis=1)
-        return out
+        out = np.concatenate([pointwise_log_likelihood(model, curve, observables, theta[i : i + BLOCK]).sum(axis=1)
+                              for i in range(0, len(theta), BLOCK)])
+        calls["sets"] += len(theta)
+        if progress and calls["sets"] >= calls["next"]:
+            calls["next"] += 20000
+            print(f"  {model.material.name}: {calls['sets']} likelihood evaluations, {time.perf_counter() - start:.0f} s",
+                  file=sys.stderr)
+        return np.where(np.isfinite(out), out, -1e300)  # nautilus needs finite numbers
 
-    initial = _start(model, log_prob, rng, walkers)
-    sampler = emcee.EnsembleSampler(walkers, model.ndim, log_prob, vectorize=True,
-                                    moves=[(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)])
-    sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
-    for k, _ in enumerate(sampler.sample(initial, iterations=steps)):
-        if progress and (k + 1) % max(1, steps // 5) == 0:
-            print(f"  {model.material.name}: {k + 1}/{steps} steps, {time.perf_counter() - start:.0f} s", file=sys.stderr)
-    chain = sampler.get_chain(discard=steps // 2)  # (draws, walkers, D)
-    posterior = {n: chain[:, :, j].T for j, n in enumerate(model.names)}  # (chain, draw) for ArviZ
-    rhat = az.rhat(az.from_dict(posterior=posterior))
-    ess = az.ess(az.from_dict(posterior=posterior))
-    flat = chain.reshape(-1, model.ndim)
-    kept = flat[rng.choice(len(flat), min(DRAWS_FOR_LOO, len(flat)), replace=False)]
+    def rescale(u):
+        return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
+
+    sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live, n_networks=1, vectorized=True,
+                      seed=int(rng.integers(2**31)))
+    sampler.run(n_eff=EFFECTIVE_DRAWS, discard_exploration=True, verbose=False)
+    points, log_w, _ = sampler.posterior()
+    w = np.exp(log_w - log_w.max())
+    effective = float(w.sum() ** 2 / np.sum(w**2))
+    kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]
+    rng.shuffle(kept)
     ll = np.concatenate([pointwise_log_likelihood(model, curve, observables, kept[i : i + BLOCK])
                          for i in range(0, len(kept), BLOCK)])
     labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
     return MaterialFit(model.material.name, model.material.description, list(model.names), kept, record,
-                       float(max(rhat[n].item() for n in model.names)), float(min(ess[n].item() for n in model.names)),
-                       float(np.mean(sampler.acceptance_fraction)), _bands(model, curve, kept[:200], rng),
+                       float(sampler.log_z), effective, int(sampler.n_like), _bands(model, curve, kept[:200], rng),
                        time.perf_counter() - start)
-
-
-def _start(model: LightCurveModel, log_prob, rng: np.random.Generator, walkers: int) -> np.ndarray:
-    """(walkers, D) starting points: the global optimum of a differential-evolution search of the prior's unit cube
-    (scipy, its generations evaluated in blocks), polished by L-BFGS-B (forward differences, one batch of D + 1 sets
-    per gradient); the walkers spread about it by each coordinate's own curvature there."""
-    from scipy.optimize import differential_evolution, minimize
-
-    d = model.ndim
-
-    def to_theta(u):
-        u = np.clip(np.atleast_2d(u), 1e-12, 1 - 1e-12)
-        return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
-
-    def negative(columns):  # (D, S) -> (S,), as scipy's vectorized search calls it
-        theta = to_theta(np.asarray(columns).T)
-        values = np.concatenate([log_prob(theta[i : i + BLOCK]) for i in range(0, len(theta), BLOCK)])
-        return np.where(np.isfinite(values), -values, 1e300)
-
-    found = differential_evolution(negative, [(0.0, 1.0)] * d, vectorized=True, updating="deferred", popsize=15,
-                                   maxiter=GENERATIONS, tol=1e-8, polish=False, seed=int(rng.integers(2**32)))
-
-    def objective(u):
-        # forward differences away from the cube's nearer face: D + 1 sets per call (a model call costs their square)
-        h = np.where(u < 0.5, 1e-7, -1e-7)
-        rows = np.repeat(u[None, :], d + 1, axis=0)
-        rows[1:] += np.diag(h)
-        v = log_prob(to_theta(rows))
-        if not np.isfinite(v[0]):
-            return 1e300, np.zeros(d)
-        grad = np.where(np.isfinite(v[1:]), (v[1:] - v[0]) / h, 0.0)
-        return -float(v[0]), -grad
-
-    polished = minimize(objective, np.clip(found.x, 1e-9, 1 - 1e-9), jac=True, method="L-BFGS-B",
-                        bounds=[(1e-9, 1 - 1e-9)] * d, options={"maxiter": 500})
-    best_u = polished.x if polished.fun <= found.fun else found.x
-    # each coordinate's step to a drop of 1/2 in log posterior (its conditional SD), from a second difference
-    h = 1e-4
-    rows = np.repeat(best_u[None, :], 2 * d + 1, axis=0)
-    rows[1 : d + 1] += np.diag(np.full(d, h))
-    rows[d + 1 :] -= np.diag(np.full(d, h))
-    v = log_prob(to_theta(np.clip(rows, 1e-12, 1 - 1e-12)))
-    curvature = -(v[1 : d + 1] + v[d + 1 :] - 2 * v[0]) / h**2
-    usable = np.isfinite(curvature) & (curvature > 0)
-    spread = np.full(d, 1e-3)
-    spread[usable] = 1.0 / np.sqrt(curvature[usable])
-    u = best_u + 0.5 * np.minimum(spread, 0.05) * rng.standard_normal((walkers, d))
-    return to_theta(np.clip(u, 1e-9, 1 - 1e-9))
 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:
@@ -209,14 +166,16 @@ def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Gene
 
 
 def ranking(fits: list[MaterialFit]) -> list[dict]:
-    """The candidates by ELPD-LOO, best first, each with its difference to the best and that difference's paired SE."""
+    """The candidates by ELPD-LOO, best first, each with its difference to the best and that difference's paired SE,
+    and its ln Z with the difference to the first's (ln of the Bayes factor against it)."""
     order = sorted(fits, key=lambda f: -f.loo["elpd_loo"])
     top = order[0].loo["pointwise"]
     rows = []
     for f in order:
         d = f.loo["pointwise"] - top
         rows.append({"material": f.material, "elpd": f.loo["elpd_loo"], "elpd_se": f.loo["elpd_loo_se"],
-                     "delta_elpd": float(d.sum()), "delta_elpd_se": float(np.sqrt(len(d) * np.var(d)))})
+                     "delta_elpd": float(d.sum()), "delta_elpd_se": float(np.sqrt(len(d) * np.var(d))),
+                     "log_evidence": f.log_evidence, "delta_log_evidence": f.log_evidence - order[0].log_evidence})
     return rows
 
 
@@ -268,7 +227,8 @@ class LightCurveInversion:
                 "parameters": {k: v for k, v in best.items() if k not in ANGLES},
                 "observables": self.observables,
                 "candidates": {f.material: {"description": f.description, "parameters": f.summary(),
-                                            "rhat_max": f.rhat_max, "ess_min": f.ess_min, "acceptance": f.acceptance,
+                                            "log_evidence": f.log_evidence, "effective_draws": f.effective_draws,
+                                            "likelihood_calls": f.likelihood_calls,
                                             "p_loo": f.loo["p_loo"], "pareto_k_max": float(np.max(f.loo["pareto_k"])),
                                             "seconds": f.seconds} for f in self.fits},
                 "times_utc": [t.strftime("%Y-%m-%dT%H:%M:%SZ") for t in self.curve.times_utc],

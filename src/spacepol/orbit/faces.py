@@ -78,3 +78,20 @@ def target_faces(path) -> list[Face]:
     them (``attitude.turned``), as written where it has none."""
     faces, attitude = read_target(path)
     return faces if attitude is None else turned(faces, attitude)
+
+
+def write_target(path, faces: list[Face], attitude: Attitude | None = None) -> Path:
+    """A target TOML file that ``read_target`` reads back as ``faces`` and ``attitude`` (None: no attitude table)."""
+
+    def value(v):
+        return f'"{v}"' if isinstance(v, str) else repr(float(v))
+
+    lines = [] if attitude is None else ["attitude = {" + ", ".join(f"{k} = {value(v)}" for k, v in attitude.to_json().items()) + "}"]
+    for face in faces:
+        lines += ["[[faces]]", f'name = "{face.name}"', f"area_m2 = {value(face.area_m2)}", f'orientation = "{face.orientation}"',
+                  f"normal = [{', '.join(value(v) for v in face.normal)}]"]
+        if face.material is not None:
+            lines.append("material = {" + ", ".join(f"{k} = {value(v)}" for k, v in face.material.items()) + "}")
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import reduce
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -21,6 +22,7 @@ _PI = np.pi
 _TINY = 1e-30
 SUBDIVISIONS = 4  # arcs per cubic piece whose control points are held inside K
 INNER = 0.8  # the share of the way to the spline's realizability limit that is kept unchanged
+SHARPNESS = 1000.0  # the pull's smooth maximum over the control points' gauges: log-sum-exp at this sharpness
 
 # the 14 box coordinates, in order: at 0 deg (m22 = m33, m44), at 60 and 120 deg (m22, the split of m33 - m44,
 # then m12, the sum m33 + m44 and m34 inside their ball), at 180 deg (m22 = -m33, m44)
@@ -171,6 +173,13 @@ def spline_gauge(nodes: NodeValues):
     return jnp.max(control_point_gauges(nodes), axis=0)
 
 
+def smooth_spline_gauge(nodes: NodeValues):
+    """A smooth upper bound on ``spline_gauge``: the log-sum-exp of the control points' gauges at ``SHARPNESS``.
+    It exceeds the largest gauge by at most log(number of control points) / ``SHARPNESS``, so a pull by it keeps the
+    spline realizable, and it has no kink where two control points tie for the largest gauge."""
+    gauges = control_point_gauges(nodes)
+    top = jax.lax.stop_gradient(jnp.max(gauges, axis=0))
+    return top + jnp.log(jnp.sum(jnp.exp(SHARPNESS * (gauges - top)), axis=0)) / SHARPNESS
 
 
 def realizable_nodes(u) -> NodeValues:
@@ -179,7 +188,7 @@ def realizable_nodes(u) -> NodeValues:
     spline's limit along their ray)."""
     nodes = node_values(u)
     t = nodes_gauge(nodes)  # <= 1 by construction
-    q = t / jnp.maximum(spline_gauge(nodes), _TINY)  # the nodes' extent over the spline's along this ray, <= 1
+    q = t / jnp.maximum(smooth_spline_gauge(nodes), _TINY)  # the nodes' extent over the spline's along this ray, <= 1
     knee = INNER * q
     outer = knee + (t - knee) * (q - knee) / (1.0 - knee)
     factor = jnp.where(t > knee, outer / jnp.maximum(t, _TINY), 1.0)

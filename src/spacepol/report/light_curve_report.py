@@ -55,6 +55,9 @@ def attitude_figure(fit) -> Figure | None:
     return fig
 
 
+LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider than this is reported as not determined
+
+
 def write_light_curve_report(inversion, out: Path) -> dict:
     """lightcurve.json, light_curve.png, attitude_corner.png (where the attitude was inferred) and report.html in
     ``out``; returns lightcurve.json's content."""
@@ -67,17 +70,23 @@ def write_light_curve_report(inversion, out: Path) -> dict:
     if corner_fig is not None:
         save_figure(corner_fig, out / "attitude_corner.png")
     rows = [[r["material"], f"{r['elpd']:.1f} +- {r['elpd_se']:.1f}", f"{r['delta_elpd']:.1f} +- {r['delta_elpd_se']:.1f}",
-             f"{content['candidates'][r['material']]['rhat_max']:.3f}"] for r in content["ranking"]]
+             f"{r['delta_log_evidence']:.1f}", f"{content['candidates'][r['material']]['effective_draws']:.0f}"]
+            for r in content["ranking"]]
     second = content["ranking"][1] if len(content["ranking"]) > 1 else None
     verdict = f"The light curve reads as {content['best']}"
     if second is not None:
         gap = -second["delta_elpd"] / max(second["delta_elpd_se"], 1e-300)
         verdict += (f", ahead of {second['material']} by {-second['delta_elpd']:.1f} +- {second['delta_elpd_se']:.1f} in "
                     f"ELPD-LOO ({gap:.1f} SE: {'decisive' if gap >= 2 else 'not decisive'}).")
+    loose = [k for k, v in content["attitude"].items() if v["q95"] - v["q05"] > LOOSE_ATTITUDE_DEG]
+    if loose:
+        verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "
+                    f"modes or a direction the pass does not see): {', '.join(loose)}.")
     estimates = [[k, f"{v['median']:.4g}", f"[{v['q05']:.4g}, {v['q95']:.4g}]"]
                  for k, v in (content["attitude"] | content["parameters"]).items()]
     sections = [("Verdict", H.paragraph(verdict)),
-                ("Materials ranked by ELPD-LOO", H.table(["material", "ELPD-LOO", "delta vs best", "R-hat max"], rows)),
+                ("Materials ranked by ELPD-LOO", H.table(["material", "ELPD-LOO", "delta vs best", "ln Z - ln Z of the first",
+                                                                 "effective draws"], rows)),
                 (f"{content['best']}: posterior median and 90 % interval", H.table(["parameter", "median", "90 %"], estimates)),
                 ("Light curve", H.image(H.png_file_to_data_uri(out / "light_curve.png")))]
     if corner_fig is not None:

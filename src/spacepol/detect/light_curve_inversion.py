@@ -165,9 +165,17 @@ def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Gene
     return out
 
 
+def _points_carrying_half(difference: np.ndarray) -> int:
+    """The fewest measured points whose pointwise ELPD differences make up half the total (0 for none): where it is
+    one or two, the paired SE rests on those few and a normal reading of it is unsafe."""
+    losses = np.sort(-difference)[::-1]
+    total = losses.sum()
+    return 0 if total <= 0 else int(np.searchsorted(np.cumsum(losses), 0.5 * total) + 1)
+
+
 def ranking(fits: list[MaterialFit]) -> list[dict]:
     """The candidates by ELPD-LOO, best first, each with its difference to the best and that difference's paired SE,
-    and its ln Z with the difference to the first's (ln of the Bayes factor against it)."""
+    how many points carry half of it, and its ln Z with the difference to the first's (ln of the Bayes factor)."""
     order = sorted(fits, key=lambda f: -f.loo["elpd_loo"])
     top = order[0].loo["pointwise"]
     rows = []
@@ -175,7 +183,8 @@ def ranking(fits: list[MaterialFit]) -> list[dict]:
         d = f.loo["pointwise"] - top
         rows.append({"material": f.material, "elpd": f.loo["elpd_loo"], "elpd_se": f.loo["elpd_loo_se"],
                      "delta_elpd": float(d.sum()), "delta_elpd_se": float(np.sqrt(len(d) * np.var(d))),
-                     "log_evidence": f.log_evidence, "delta_log_evidence": f.log_evidence - order[0].log_evidence})
+                     "log_evidence": f.log_evidence, "delta_log_evidence": f.log_evidence - order[0].log_evidence,
+                     "points_carrying_half": _points_carrying_half(d)})
     return rows
 
 

@@ -77,7 +77,11 @@ def write_light_curve_report(inversion, out: Path) -> dict:
     if second is not None:
         gap = -second["delta_elpd"] / max(second["delta_elpd_se"], 1e-300)
         verdict += (f", ahead of {second['material']} by {-second['delta_elpd']:.1f} +- {second['delta_elpd_se']:.1f} in "
-                    f"ELPD-LOO ({gap:.1f} SE: {'decisive' if gap >= 2 else 'not decisive'}).")
+                    f"ELPD-LOO ({gap:.1f} SE: {'decisive' if gap >= 2 else 'not decisive'}) and by "
+                    f"{-second['delta_log_evidence']:.1f} in ln Z.")
+        if 0 < second["points_carrying_half"] <= 2:
+            verdict += (f" Half the ELPD difference sits in {second['points_carrying_half']} measured point(s), so its SE "
+                        "rests on those few: read the gap from ln Z and the figure rather than in SEs.")
     loose = [k for k, v in content["attitude"].items() if v["q95"] - v["q05"] > LOOSE_ATTITUDE_DEG]
     if loose:
         verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "

@@ -92,6 +92,12 @@ def test_observe_from_the_command_line_writes_its_files_and_bad_input_is_one_lin
     assert content["satellite"] == "ISS (ZARYA)" and len(content["times"]) == 13 and content["p_false_alarm"] == 1e-3
     assert (tmp_path / "obs" / "light_curves.png").stat().st_size > 0 and "P_d" in (tmp_path / "obs" / "report.html").read_text()
     assert "best P_d" in done.stdout
+    # the exposure follows the user's sky: 2.4 mag brighter, the pass's auto exposure at that sky, not at the default
+    bright = run_cli(*args, "--sky-zenith-mag", "3.0", "--out", tmp_path / "bright")
+    assert bright.returncode == 0, bright.stderr
+    g = pass_geometry(read_tle(tle), (43.1333, 125.5333, 200.0), "2014-01-21T00:33:00Z", "2014-01-21T00:39:00Z", 30.0)
+    exposure = json.loads((tmp_path / "bright" / "observe.json").read_text())["camera"]["exposure_s"]
+    assert exposure == auto_exposure_s(Camera(), g, 3.0) != auto_exposure_s(Camera(), g, 5.40), exposure
     for bad, words in ((["--site", "95,125"], "--site '95,125'"), (["--start", "2014-01-21T00:33:00"], "UTC offset"),
                        (["--p-max", "1.5"], "--p-max 1.5")):
         argv = list(args)

@@ -203,7 +203,7 @@ def camera_given(camera):
     return camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
 
 
-def exposed_for(camera, geometry, sky_magnitude_zenith: float = 5.40):
+def exposed_for(camera, geometry, sky_magnitude_zenith: float):
     """``camera`` as it is where its exposure was given; else with the exposure that keeps the brightest sky of the
     pass at half the well (``auto_exposure_s``)."""
     from dataclasses import replace
@@ -246,7 +246,7 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
             fixed_material(face.material)
     element_set = read_tle(tle, satellite)
     geometry = pass_geometry(element_set, site, start, end, step_s, faces)
-    camera = exposed_for(camera, geometry)
+    camera = exposed_for(camera, geometry, sky_magnitude_zenith)
     scenario = default_scenario()
     scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
     inner, params, material = material_samples(result.model, result.samples(), scenario,

@@ -121,7 +121,7 @@ def main() -> None:
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}", flush=True)
     rng = np.random.default_rng(args.seed)
     rows, covered, widths = [], [], []
-    for k, case in enumerate(cases(4 * args.cases, rng)):
+    for k, case in enumerate(cases(4 * len(LIBRARY) * args.cases, rng)):  # room for skipped passes
         if len(rows) == args.cases:
             break
         if len(rows) % len(LIBRARY) != k % len(LIBRARY):  # keep the materials in turn after a skipped case
@@ -146,6 +146,9 @@ def main() -> None:
               f"effective draws >= {pol['effective_min']:.0f}; {pol['seconds']:.0f} + {flux['seconds']:.0f} s",
               flush=True)
     n = len(covered)
+    if not n:
+        print("no case could be rendered")
+        return
     print(f"\n90 % attitude intervals holding the truth: {sum(covered)}/{n} ({100 * sum(covered) / n:.0f} %; a binomial "
           f"90 % range for {n} intervals: {np.percentile(np.random.default_rng(1).binomial(n, 0.9, 100000), [5, 95])}); "
           f"widths {min(widths):.2f}-{max(widths):.2f} deg")

@@ -115,15 +115,14 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode."""
     from nautilus import Sampler
 
-    from ..infer.engines.nested import replicate_draws
+    from ..infer.engines.nested import kish_draws, replicate_draws
 
     start = time.perf_counter()
     calls = {"sets": 0, "next": 20000}
 
     def log_likelihood(theta):
         theta = np.atleast_2d(theta)
-        out = np.concatenate([pointwise_log_likelihood(model, curve, observables, theta[i : i + BLOCK]).sum(axis=1)
-                              for i in range(0, len(theta), BLOCK)])
+        out = pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1)
         calls["sets"] += len(theta)
         if progress and calls["sets"] >= calls["next"]:
             calls["next"] += 20000
@@ -138,12 +137,10 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
                       seed=int(rng.integers(2**31)))
     sampler.run(n_eff=EFFECTIVE_DRAWS, discard_exploration=True, verbose=False)
     points, log_w, _ = sampler.posterior()
-    w = np.exp(log_w - log_w.max())
-    effective = float(w.sum() ** 2 / np.sum(w**2))
+    effective = kish_draws(log_w)
     kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]
     rng.shuffle(kept)
-    ll = np.concatenate([pointwise_log_likelihood(model, curve, observables, kept[i : i + BLOCK])
-                         for i in range(0, len(kept), BLOCK)])
+    ll = pointwise_log_likelihood(model, curve, observables, kept)
     labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))

@@ -27,6 +27,12 @@ def replicate_draws(points, log_w, rng: np.random.Generator, size: int) -> np.nd
     return np.minimum(np.searchsorted(np.cumsum(w), positions), len(points) - 1)
 
 
+def kish_draws(log_w) -> float:
+    """How many independent draws weighted points are worth (Kish: 1 / sum of the squared normalised weights)."""
+    w = np.exp(np.asarray(log_w, float) - logsumexp(log_w))
+    return float(1.0 / np.sum(w**2))
+
+
 def combine_evidence(log_z: np.ndarray) -> tuple[float, float]:
     """(ln of the mean evidence, its standard error) of independent replicates' ln Z."""
     log_z = np.asarray(log_z, float)
@@ -56,8 +62,7 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
                           vectorized=True, seed=int(rng.integers(2**31)))
         sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False)
         points, log_w, log_l = sampler.posterior()
-        w = np.exp(log_w - logsumexp(log_w))
-        effective.append(float(1.0 / np.sum(w**2)))
+        effective.append(kish_draws(log_w))
         log_z.append(float(sampler.log_z))
         calls += int(sampler.n_like)
         chains.append((points, log_w, log_l))

@@ -178,3 +178,30 @@ def test_nested_sampling_gives_the_evidence_and_the_posterior(data):
     """Three free parameters with their default priors."""
     reference = spacepol.invert(data, "paper", prior=PRIOR, seed=1)
     _check_nested(data, PRIOR, Uniform(0.02, 1.58), reference, {"live": 200, "replicates": 3, "effective_draws": 800})
+
+
+def test_sampling_after_the_exploration_stops_at_its_likelihood_budget():
+    """``explore_then_sample``: on a posterior far narrower than the prior the sampling phase stops after its budget of
+    likelihood calls per live point, short of an unreachable number of effective draws, and says so; a reachable
+    number is reached (control) within the same budget."""
+    from nautilus import Sampler
+
+    from spacepol.infer.engines.nested import explore_then_sample
+
+    class Counted(Sampler):
+        def run(self, **options):
+            self.calls_before.append(self.n_like)
+            return super().run(**options)
+
+    def sampler():
+        s = Counted(lambda u: u, lambda x: -0.5 * np.sum(((x - 0.5) / 0.03) ** 2, axis=-1), n_dim=2, n_live=50,
+                    n_networks=1, vectorized=True, seed=3)
+        s.calls_before = []
+        return s
+
+    capped = sampler()
+    assert not explore_then_sample(capped, effective_draws=10**6, calls_per_live_point=4)
+    spent = capped.n_like - capped.calls_before[1]  # after the exploration
+    assert 4 * 50 <= spent <= 4 * 50 + 50, (capped.calls_before, spent)  # nautilus stops at the first batch past it
+    reached = sampler()
+    assert explore_then_sample(reached, effective_draws=150, calls_per_live_point=4), reached.n_eff

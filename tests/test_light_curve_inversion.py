@@ -14,6 +14,7 @@ from spacepol.detect.light_curve_model import LightCurveModel
 from spacepol.detect.materials import LIBRARY, material
 from spacepol.detect.target import target_light
 from spacepol.io.light_curve import write_light_curve
+from spacepol.report.light_curve_report import write_light_curve_report
 from spacepol.orbit import Attitude, Face, faces_from_toml, pass_geometry, read_tle, turned, write_target
 from spacepol.paths import bundled
 
@@ -112,6 +113,11 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     saved = folder / "fit" / "fits" / "solar_glass.npz"
     assert MaterialFit.load(saved, "the inputs of another run") is None  # another run's inputs: fitted afresh
     assert MaterialFit.load(folder / "fit" / "fits" / "kapton.npz", "any") is None  # none saved: fitted
+    # a candidate whose sampler ran out of its budget short of the draws is named in the verdict; the run's are not
+    assert "Few effective draws" not in (folder / "fit" / "report.html").read_text()
+    rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "aluminium" else f for f in inversion.fits])
+    write_light_curve_report(rough, folder / "rough")
+    assert "Few effective draws (under 200) for aluminium (3)" in (folder / "rough" / "report.html").read_text()
 
 
 @pytest.mark.parametrize("change, words", [

@@ -198,6 +198,32 @@ class MirrorScatter:
         """The bins as text ("0-20 deg", ...)."""
         return [f"{lo:g}-{hi:g} deg" for lo, hi in zip(self.edges_deg[:-1], self.edges_deg[1:])]
 
+    def noise_profile(self, data, tolerance_deg: float = 0.01) -> np.ndarray:
+        """(3, N): per element group (``GROUPS``' order), the spread at each row's exit angle (linear between the bins'
+        centres, the end bins' beyond them; bins without enough mirror pairs skipped) over its mean at the rows of
+        ``data``'s reciprocal pairs: the likelihood's noise profile (``Mueller.noise_profile``), whose inferred level
+        is then the noise where the reciprocal pairs lie, comparable with what they measure. Fine bins
+        (``PROFILE_EDGES_DEG``) follow a steep rise; a robust SD of a bin whose noise varies across it falls short of
+        its RMS."""
+        rows = np.unique(reciprocal_pairs(data, tolerance_deg))
+        if rows.size == 0:
+            raise ValueError("a noise profile needs reciprocal pairs to set its level")
+        edges = np.asarray(self.edges_deg, float)
+        centres = 0.5 * (edges[:-1] + edges[1:])
+        exit_deg = np.abs(np.asarray(data.theta_r, float))
+        out = np.empty((len(GROUPS), len(data)))
+        for g, group in enumerate(GROUPS):
+            sd = np.asarray(self.sd[group], float)
+            known = np.isfinite(sd)
+            if not known.any():
+                raise ValueError(f"no exit-angle bin holds enough mirror pairs for the {group} group")
+            spread = np.interp(exit_deg, centres[known], sd[known])
+            out[g] = spread / spread[rows].mean()
+        return out
+
+
+PROFILE_EDGES_DEG = tuple(float(e) for e in range(0, 91, 10))  # exit-angle bins for ``MirrorScatter.noise_profile``
+
 
 def mirror_scatter(data, edges_deg=EXIT_EDGES_DEG, tolerance_deg: float = 0.01) -> MirrorScatter:
     """``MirrorScatter`` of ``data`` (one wavelength; needs the Mueller matrix): how the measurement's own spread

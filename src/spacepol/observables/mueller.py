@@ -74,7 +74,9 @@ class Mueller(Observable):
     contains = ("stokes", "dop", "aop")  # m21, m31, m41 are S1, S2, S3 / S0 for unpolarized incidence
     columns = ELEMENTS
     error_columns = ("m_err",) + tuple(f"{e}_err" for e in ELEMENTS)
-    arrays = ("mueller", "mueller_err")  # (4, 4, N): the BRDF Mueller matrix (M_11 = BRDF, or 1) and m_ij's errors
+    # (4, 4, N): the BRDF Mueller matrix (M_11 = BRDF, or 1) and m_ij's errors; (3, N): factors on each group's
+    # inferred noise level over the rows (``noise_profile``), set by a caller, never read from a file
+    arrays = ("mueller", "mueller_err", "mueller_noise_profile")
 
     def check_header(self, header, path, line):
         """All 15 normalised elements or none; errors as m_err, or per element for all 15 (m_err covering the rest)."""
@@ -118,6 +120,12 @@ class Mueller(Observable):
     def errors(self, data):
         err = data.get("mueller_err")
         return None if err is None else {e: err[index(e)] for e in ELEMENTS}
+
+    def noise_profile(self, channel, data):
+        """The rows' factors on the channel's group level from the data set's ``mueller_noise_profile`` ((3, N),
+        ``GROUPS``' order; ``MirrorScatter.noise_profile`` makes one from the measurement's own spread), or None."""
+        profile = data.get("mueller_noise_profile")
+        return None if profile is None else np.asarray(profile)[list(GROUPS).index(GROUP_OF[channel])]
 
     def predict(self, prediction):
         return normalised(prediction.mueller)

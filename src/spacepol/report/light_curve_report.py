@@ -55,6 +55,7 @@ def attitude_figure(fit) -> Figure | None:
     return fig
 
 
+FEW_EFFECTIVE_DRAWS = 200  # below this a candidate's posterior summary is rough (the sampler's budget ran out)
 LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider than this is reported as not determined
 
 
@@ -82,6 +83,12 @@ def write_light_curve_report(inversion, out: Path) -> dict:
         if 0 < second["points_carrying_half"] <= 2:
             verdict += (f" Half the ELPD difference sits in {second['points_carrying_half']} measured point(s), so its SE "
                         "rests on those few: read the gap from ln Z and the figure rather than in SEs.")
+    rough = [f"{m} ({c['effective_draws']:.0f})" for m, c in content["candidates"].items()
+             if c["effective_draws"] < FEW_EFFECTIVE_DRAWS]
+    if rough:
+        verdict += (f" Few effective draws (under {FEW_EFFECTIVE_DRAWS}) for {', '.join(rough)}: the sampler's budget ran "
+                    "out on a posterior far narrower than its last shell, so those posteriors and ELPD-LOO are rough; "
+                    "ln Z is still an estimate.")
     loose = [k for k, v in content["attitude"].items() if v["q95"] - v["q05"] > LOOSE_ATTITUDE_DEG]
     if loose:
         verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "

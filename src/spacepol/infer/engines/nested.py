@@ -33,6 +33,17 @@ def kish_draws(log_w) -> float:
     return float(1.0 / np.sum(w**2))
 
 
+def explore_then_sample(sampler, effective_draws: int, calls_per_live_point: int) -> bool:
+    """Run a nautilus ``sampler``'s exploration to its end, then sample its shells until the points are worth
+    ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent; whether
+    the draws were reached. The cap matters where a posterior is far narrower than the last shell: there the points
+    gain almost no effective draws per call, and an uncapped run goes on for hours."""
+    sampler.run(n_eff=0, discard_exploration=True, verbose=False)
+    sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False,
+                n_like_max=sampler.n_like + calls_per_live_point * sampler.n_live)
+    return sampler.n_eff >= effective_draws
+
+
 def combine_evidence(log_z: np.ndarray) -> tuple[float, float]:
     """(ln of the mean evidence, its standard error) of independent replicates' ln Z."""
     log_z = np.asarray(log_z, float)

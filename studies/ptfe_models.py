@@ -1,7 +1,7 @@
 """NIST's PTFE (Germer, Appl. Opt. 56, 9333, 2017) under competing models, jointly at every wavelength, every row:
 which model reaches the noise the measurement shows itself, and what each says about the index.
 
-    python studies/ptfe_models.py [--wavelength-um all] [--in-plane] [--mask-anisotropic]
+    python studies/ptfe_models.py [--wavelength-um all] [--in-plane] [--mask-anisotropic] [--noise-profile]
                                   [--models paper,...,specular+smith+subsurface+phase_matrix+polarization_memory]
                                   [--posterior laplace|emcee] [--max-steps 4000] [--search-every 1] [--seed 0]
                                   [--out reports/ptfe_models]
@@ -9,6 +9,8 @@ which model reaches the noise the measurement shows itself, and what each says a
 1. The noise the data measure themselves, per wavelength and Mueller element group (reciprocal pairs).
 2. The sample's anisotropy from the data alone: per mirror pair (dphi, -dphi) the asymmetry chi^2 against that noise
    (``reciprocity.mirror_asymmetry``); with ``--mask-anisotropic`` the rows of pairs beyond the noise are left out.
+   With ``--noise-profile`` each row's noise is the measurement's own (the reciprocal pairs' at its wavelength, the
+   mirror pairs' rise with its exit angle) times one inferred factor per element group.
 3. Per model: the posterior maximum (``find_optimum_profiled``; on every n-th row, then polished on all, with
    ``--search-every``), then diagnose's posterior (Laplace-IS where its
    checks trust it, else emcee up to ``--max-steps``), ELPD-LOO, the inferred noise against the measured one per
@@ -36,7 +38,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from spacepol.criticism.reciprocity import mirror_asymmetry, mirror_scatter  # noqa: E402
+from spacepol.criticism.reciprocity import PROFILE_EDGES_DEG, mirror_asymmetry, mirror_scatter  # noqa: E402
 from spacepol.errors import SpacepolError  # noqa: E402
 from spacepol.infer.indices import INDEX_LIKE, index_findings  # noqa: E402
 from spacepol.infer.inference_data import median_fit  # noqa: E402
@@ -45,7 +47,7 @@ from spacepol.infer.optimum import find_optimum_on_every  # noqa: E402
 from spacepol.infer.posterior import Posterior  # noqa: E402
 from spacepol.io import read_measurements  # noqa: E402
 from spacepol.io.atomic import save_figure, write_json, write_text  # noqa: E402
-from spacepol.observables.mueller import GROUP_OF  # noqa: E402
+from spacepol.observables.mueller import GROUP_OF, GROUPS  # noqa: E402
 from spacepol.paths import bundled  # noqa: E402
 from spacepol.physics import Model  # noqa: E402
 from spacepol.physics.spectral import SpectralModel, wavelength_label  # noqa: E402
@@ -92,6 +94,28 @@ def exit_scatter(data) -> dict:
     mirror pairs (``reciprocity.mirror_scatter``); the reciprocal pairs, which give the noise the likelihood is
     compared with, lie at theta 30 and 45 deg only."""
     return {wavelength_label(w): mirror_scatter(data.at_wavelength(float(w))) for w in np.unique(data.wavelength_um)}
+
+
+def measured_noise_profile(data, noise: dict) -> np.ndarray:
+    """(3, N) for ``Dataset.mueller_noise_profile``: each row's group noise as the measurement shows it, the reciprocal
+    pairs' noise at its wavelength times the mirror pairs' rise with the exit angle there
+    (``MirrorScatter.noise_profile``), in ``profile_unit``. The likelihood's inferred level of each group over that
+    unit is then one factor on the measured noise, the same at every wavelength and exit angle: 1 where the model
+    leaves only the measurement's own noise."""
+    out = np.empty((len(GROUPS), len(data)))
+    for w in np.unique(data.wavelength_um):
+        at = np.flatnonzero(data.wavelength_um == w)
+        one = data.select(at)
+        shape = mirror_scatter(one, PROFILE_EDGES_DEG).noise_profile(one)
+        out[:, at] = shape * np.array([noise[wavelength_label(w)][g] for g in GROUPS])[:, None]
+    return out / profile_unit(data, noise)[:, None]
+
+
+def profile_unit(data, noise: dict) -> np.ndarray:
+    """Per group, the mean over ``data``'s wavelengths of the reciprocal pairs' noise: ``measured_noise_profile`` is
+    in its units, so that the inferred level stays a noise (inside its prior) and level / unit is the factor on the
+    measured noise."""
+    return np.array([np.mean([noise[wavelength_label(w)][g] for w in np.unique(data.wavelength_um)]) for g in GROUPS])
 
 
 def exit_ratios(z: dict, data, noise: dict, scatter: dict) -> dict:
@@ -178,6 +202,7 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict, sc
         "laplace_refused": "" if method != "laplace" else refusal, "rhat_max": s.diagnostics["rhat_max"],
         "elpd_loo": s.fit["elpd_loo"], "elpd_loo_se": s.fit["elpd_loo_se"],
         "inferred_noise": {k: v["median"] for k, v in s.parameters.items() if k.startswith("sigma_m_")},
+        "noise_factor": noise_factors(data, noise, s.parameters),
         "misfit_ratio": group_ratios(z, data),
         "misfit_by_exit": exit_ratios(z, data, noise, scatter),
         "indices": [{"name": f.name, "median": f.median, "q05": f.q05, "q95": f.q95, "determined": f.determined,
@@ -186,6 +211,15 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict, sc
         "seconds": time.perf_counter() - start,
     }
     return record, inv, z
+
+
+def noise_factors(data, noise: dict, parameters: dict) -> dict | None:
+    """{group: the inferred level over ``profile_unit``}, the factor on the noise the measurement shows, where the
+    fit had a noise profile (``--noise-profile``); else None."""
+    if data.get("mueller_noise_profile") is None:
+        return None
+    unit = dict(zip(GROUPS, profile_unit(data, noise)))
+    return {g: parameters[f"sigma_m_{g}"]["median"] / unit[g] for g in GROUPS if f"sigma_m_{g}" in parameters}
 
 
 def ranking(records: list[dict], pointwise: dict) -> list[dict]:
@@ -287,6 +321,13 @@ def top_findings(records: list[dict]) -> list[str]:
                        + "; they go to " + ", ".join(f"{i['name']} {i['median']:.3f}" for i in h["indices"])
                        + " (the band's edge): the data themselves, not the prior, push the indices out of the band. "
                        + risen_most(r, h))
+    if best.get("noise_factor"):
+        factors = best["noise_factor"]
+        over = [g for g, v in factors.items() if v > GOAL_RATIO]
+        out.append(f"Inferred noise of {best['model']} over the noise the measurement shows (`--noise-profile`: the "
+                   "reciprocal pairs' at each wavelength, the mirror pairs' rise with the exit angle), one factor per "
+                   "group: " + ", ".join(f"{g} {v:.2f}" for g, v in factors.items())
+                   + (f": {', '.join(over)} above {GOAL_RATIO}." if over else f": every group within {GOAL_RATIO}x."))
     ratios = {f"{g}@{w}": v for w, groups in best["misfit_ratio"].items() for g, v in groups.items()}
     above = [k for k, v in ratios.items() if v > GOAL_RATIO]
     out.append(f"Misfit of {best['model']} = RMS residual / the measured noise, per element group and wavelength: "
@@ -419,6 +460,9 @@ def main(argv=None) -> int:
     parser.add_argument("--wavelength-um", default="all")
     parser.add_argument("--in-plane", action="store_true")
     parser.add_argument("--mask-anisotropic", action="store_true")
+    parser.add_argument("--noise-profile", action="store_true", help="each row's noise as the measurement shows it "
+                        "(reciprocal pairs per wavelength, mirror pairs per exit angle), times one inferred factor "
+                        "per element group")
     parser.add_argument("--models", default=MODELS)
     parser.add_argument("--posterior", choices=("laplace", "emcee"), default="laplace")
     parser.add_argument("--max-steps", type=int, default=4000)
@@ -439,6 +483,8 @@ def main(argv=None) -> int:
     noise = measured_noise(data)  # from every row: the plane of incidence alone holds no reciprocal pair
     aniso = anisotropy(data, noise)
     scatter = exit_scatter(data)  # from every row, before any is left out: a mirror pair needs both members
+    if args.noise_profile:  # from every row, before any is left out (as the spread it rests on)
+        data.mueller_noise_profile = measured_noise_profile(data, noise)
     masked = 0
     if args.mask_anisotropic:
         drop = np.unique(np.concatenate([rows for _, rows in aniso.values()] or [np.empty(0, int)]))
@@ -447,8 +493,8 @@ def main(argv=None) -> int:
         data = data.in_plane()
     print(f"PTFE: {len(data)} geometries ({masked} anisotropic rows left out); {os.cpu_count()} cores, "
           f"load {os.getloadavg()[0]:.2f}", flush=True)
-    settings = {k: getattr(args, k) for k in ("wavelength_um", "in_plane", "mask_anisotropic", "posterior", "max_steps",
-                                              "seed", "search_every")}
+    settings = {k: getattr(args, k) for k in ("wavelength_um", "in_plane", "mask_anisotropic", "noise_profile", "posterior",
+                                              "max_steps", "seed", "search_every")}
     done, misfit, misfit_model = finished(out, settings)
     records, pointwise = [], {}
     for spec in args.models.split(","):

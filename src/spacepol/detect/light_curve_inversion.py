@@ -26,10 +26,10 @@ from .light_curve_model import LightCurveModel
 from .target import linear_polarization
 
 EFFECTIVE_DRAWS = 2000  # nested sampling stops once its weighted points are worth this many independent draws
-# ... or once it has spent this many likelihood calls per live point after its exploration: a candidate that misses
-# the curve by millions in log L has a posterior far narrower than its last shell, and its weighted points gain
-# almost no effective draws per call (white paint on a solar-glass render: 1 effective draw after 8,000 calls)
-SAMPLING_CALLS_PER_LIVE_POINT = 100
+# ... or once it has spent ``nested.SAMPLING_CALLS_PER_LIVE_POINT`` likelihood calls per live point after its
+# exploration: a candidate that misses the curve by millions in log L has a posterior far narrower than its last
+# shell, and its weighted points gain almost no effective draws per call (white paint on a solar-glass render: 1
+# effective draw after 8,000 calls)
 DRAWS_FOR_LOO = 2000
 BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
 
@@ -139,7 +139,7 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
 
     sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live, n_networks=1, vectorized=True,
                       seed=int(rng.integers(2**31)))
-    explore_then_sample(sampler, EFFECTIVE_DRAWS, SAMPLING_CALLS_PER_LIVE_POINT)
+    explore_then_sample(sampler, EFFECTIVE_DRAWS)
     points, log_w, _ = sampler.posterior()
     effective = kish_draws(log_w)
     kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]

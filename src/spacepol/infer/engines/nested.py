@@ -33,7 +33,11 @@ def kish_draws(log_w) -> float:
     return float(1.0 / np.sum(w**2))
 
 
-def explore_then_sample(sampler, effective_draws: int, calls_per_live_point: int) -> bool:
+# after the exploration, at most this many likelihood calls per live point go into reaching the effective draws
+SAMPLING_CALLS_PER_LIVE_POINT = 100
+
+
+def explore_then_sample(sampler, effective_draws: int, calls_per_live_point: int = SAMPLING_CALLS_PER_LIVE_POINT) -> bool:
     """Run a nautilus ``sampler``'s exploration to its end, then sample its shells until the points are worth
     ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent; whether
     the draws were reached. The cap matters where a posterior is far narrower than the last shell: there the points
@@ -71,7 +75,7 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
     for r in range(replicates):
         sampler = Sampler(priors.rescale, log_likelihood, n_dim=priors.ndim, n_live=live, n_networks=networks,
                           vectorized=True, seed=int(rng.integers(2**31)))
-        sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False)
+        explore_then_sample(sampler, effective_draws)
         points, log_w, log_l = sampler.posterior()
         effective.append(kish_draws(log_w))
         log_z.append(float(sampler.log_z))

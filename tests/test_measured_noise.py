@@ -123,3 +123,15 @@ def test_a_noise_profile_from_the_mirror_pairs_makes_the_inferred_level_the_reci
         assert abs(shaped - 1) < 0.15 and flat > 1.3, (name, shaped, flat)
     for name, (shaped, flat) in _levels_at_truth(0.0).items():
         assert abs(shaped / flat - 1) < 0.15, (name, shaped, flat)
+
+
+def test_a_noise_profile_of_the_wrong_shape_or_sign_is_one_error_naming_it():
+    from spacepol.errors import ParameterError
+
+    data, _ = _grazing_noise_render(0.0, seed=1)
+    model = Model.from_string("specular+subsurface")
+    for bad, words in [(np.ones((2, len(data))), "shape (2,"), (-np.ones((3, len(data))), "values <= 0")]:
+        data.mueller_noise_profile = bad
+        with pytest.raises(ParameterError, match="mueller_noise_profile") as error:
+            Likelihood(data, model, observables=["mueller"])
+        assert words in str(error.value), str(error.value)

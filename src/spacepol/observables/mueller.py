@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputFileError
+from ..errors import InputFileError, ParameterError
 from ..priors import LogUniform
 from ..physics.arrays import array_module
 from ..physics.parameter import Parameter
@@ -125,7 +125,14 @@ class Mueller(Observable):
         """The rows' factors on the channel's group level from the data set's ``mueller_noise_profile`` ((3, N),
         ``GROUPS``' order; ``MirrorScatter.noise_profile`` makes one from the measurement's own spread), or None."""
         profile = data.get("mueller_noise_profile")
-        return None if profile is None else np.asarray(profile)[list(GROUPS).index(GROUP_OF[channel])]
+        if profile is None:
+            return None
+        profile = np.asarray(profile, float)
+        if profile.shape != (len(GROUPS), len(data)) or not np.all(np.isfinite(profile) & (profile > 0)):
+            raise ParameterError(f"{data.source}: mueller_noise_profile must hold {len(GROUPS)} x {len(data)} finite "
+                                 f"factors > 0 (one per element group and row); it has shape {profile.shape}"
+                                 + ("" if profile.shape != (len(GROUPS), len(data)) else " and values <= 0 or not finite"))
+        return profile[list(GROUPS).index(GROUP_OF[channel])]
 
     def predict(self, prediction):
         return normalised(prediction.mueller)

@@ -128,10 +128,12 @@ class Mueller(Observable):
         if profile is None:
             return None
         profile = np.asarray(profile, float)
-        if profile.shape != (len(GROUPS), len(data)) or not np.all(np.isfinite(profile) & (profile > 0)):
-            raise ParameterError(f"{data.source}: mueller_noise_profile must hold {len(GROUPS)} x {len(data)} finite "
-                                 f"factors > 0 (one per element group and row); it has shape {profile.shape}"
-                                 + ("" if profile.shape != (len(GROUPS), len(data)) else " and values <= 0 or not finite"))
+        wanted = (f"{data.source}: mueller_noise_profile must hold {len(GROUPS)} x {len(data)} finite factors > 0 "
+                  "(one per element group and row)")
+        if profile.shape != (len(GROUPS), len(data)):
+            raise ParameterError(f"{wanted}; it has shape {profile.shape}")
+        if not np.all(np.isfinite(profile) & (profile > 0)):
+            raise ParameterError(f"{wanted}; it has values <= 0 or not finite")
         return profile[list(GROUPS).index(GROUP_OF[channel])]
 
     def predict(self, prediction):

@@ -260,7 +260,6 @@ _POOL_SCRIPT = """
 import os, sys, time
 from concurrent.futures import ProcessPoolExecutor
 import multiprocessing
-from spacepol.criticism.candidate_fits import CandidateFits
 
 
 def pid_after(seconds):
@@ -270,6 +269,8 @@ def pid_after(seconds):
 
 if __name__ == "__main__":
     if sys.argv[1] == "fits":
+        from spacepol.criticism.candidate_fits import CandidateFits  # here: the control's processes need no spacepol
+
         pool = CandidateFits(None, workers=2)._open()
     else:  # the control: the same pool without diagnose's initializer
         pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn"))

@@ -87,15 +87,14 @@ def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered)
 
 def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_reads_the_fits(rendered):
     """The default run's version of the test above: the target file gives the true attitude, so only the material's
-    parameters are sampled. The true material first by ELPD-LOO and by a Bayes factor above e^10 (aluminium, held to
-    the true attitude, misses a few points by orders of magnitude, so the paired SE of the ELPD difference, carried by
-    those few points, is as large as the difference itself), its parameters' 99 % intervals hold the truth; the
-    report's files exist; the same command run again reads the materials already fitted, and a saved fit is used only
+    parameters are sampled. The true material first by ELPD-LOO and by a Bayes factor above e^10 against kapton (the
+    paired SE of an ELPD difference carried by a few badly missed points can be as large as the difference itself,
+    so the SE is not asserted here), its parameters' 99 % intervals hold the truth; the report's files exist; the same command run again reads the materials already fitted, and a saved fit is used only
     for its own inputs."""
     folder, csv, _, truth, _ = rendered
     attitude = Attitude(truth["yaw_deg"], truth["pitch_deg"], truth["roll_deg"])
     known = box(folder / "known.toml", None, attitude)
-    options = dict(target=known, materials="aluminium,solar_glass", live=100, seed=1, out=folder / "fit")
+    options = dict(target=known, materials="kapton,solar_glass", live=100, seed=1, out=folder / "fit")
     inversion = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, **options)
     first, second = inversion.ranking
     assert first["material"] == "solar_glass" and second["delta_log_evidence"] < -10, inversion.ranking
@@ -112,12 +111,12 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
         np.testing.assert_array_equal(f.samples, kept[f.material].samples)
     saved = folder / "fit" / "fits" / "solar_glass.npz"
     assert MaterialFit.load(saved, "the inputs of another run") is None  # another run's inputs: fitted afresh
-    assert MaterialFit.load(folder / "fit" / "fits" / "kapton.npz", "any") is None  # none saved: fitted
+    assert MaterialFit.load(folder / "fit" / "fits" / "aluminium.npz", "any") is None  # none saved: fitted
     # a candidate whose sampler ran out of its budget short of the draws is named in the verdict; the run's are not
     assert "Few effective draws" not in (folder / "fit" / "report.html").read_text()
-    rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "aluminium" else f for f in inversion.fits])
+    rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "kapton" else f for f in inversion.fits])
     write_light_curve_report(rough, folder / "rough")
-    assert "Few effective draws (under 200) for aluminium (3)" in (folder / "rough" / "report.html").read_text()
+    assert "Few effective draws (under 200) for kapton (3)" in (folder / "rough" / "report.html").read_text()
 
 
 @pytest.mark.parametrize("change, words", [

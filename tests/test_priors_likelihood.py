@@ -227,3 +227,25 @@ def test_a_fixed_index_under_the_interface_equals_the_same_index_free():
     theta_free = np.column_stack([np.full(6, 1.35) if name == "n" else params[name] * np.ones(6) for name in free.priors.names])
     np.testing.assert_allclose(fixed.log_likelihood(theta_fixed), free.log_likelihood(theta_free), rtol=1e-12)
     assert np.ptp(fixed.log_likelihood(theta_fixed)) > 0  # the sets differ
+
+
+def test_a_samplers_parameter_matrix_gives_the_dict_paths_values_through_the_same_program(tmp_path):
+    """``Posterior.summed_log_likelihood`` hands the compiled program the rows of theta as they are
+    (``Likelihood.of_matrix``): bitwise the values of the dict path (``total`` of ``to_params``), a held parameter
+    compiled in alike, and no second program compiled; control: another set gives another value."""
+    from spacepol.physics.geometry import default_grid
+
+    model, g = Model.from_string("paper"), default_grid()
+    data = Dataset(g.theta_i, g.theta_r, g.dphi)
+    data.dop, data.dop_err = model.evaluate({}, g).dop, np.full(g.size, 0.01)
+    prior = tmp_path / "p.toml"
+    prior.write_text("[rho_d]\nfixed = 0.3\n")
+    post = Posterior.build(data, model, read_prior_file(prior))
+    assert post.priors.fixed["rho_d"] == 0.3 and "rho_d" not in post.priors.names
+    theta = post.priors.sample(np.random.default_rng(8), 16)
+    fast = post.summed_log_likelihood(theta)
+    compiled = set(post.likelihood._jitted)
+    slow = post.likelihood.total(post.priors.to_params(theta))
+    np.testing.assert_array_equal(fast, slow)
+    assert set(post.likelihood._jitted) == compiled and len(compiled) == 1
+    assert len(np.unique(fast)) == len(theta)

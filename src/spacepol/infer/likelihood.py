@@ -226,19 +226,26 @@ class Likelihood:
                 v = np.asarray(v, float).reshape(-1)
                 columns.append((name, v))
                 n_sets = max(n_sets, v.size)
+        names = tuple(n for n, _ in columns)
+        matrix = set_matrix([v for _, v in columns], n_sets) if n_sets else None
+        return self.of_matrix(which, names, tuple(sorted(scalars.items())), matrix, levels)
+
+    def of_matrix(self, which: int, names: tuple, scalars: tuple, matrix, levels: tuple = ()) -> np.ndarray:
+        """``_call`` with the parameter sets already one (P, len(names)) matrix (None: no column) and the held values
+        ``scalars`` ((name, value), ... sorted by name): what a sampler's every step calls, without the dict."""
+        n_sets = 0 if matrix is None else len(matrix)
         if n_sets >= _LARGE_BLOCK_SETS:
             self._sets_in_large_calls += n_sets
         sizes = self._compiled_sizes()
         rows = _block_rows(n_sets, sizes)
         # ``total`` of a large likelihood: the pointwise program, summed (see ``total``)
         summed = which == 1 and self.compiles_one_block and rows * self.numbers_per_set <= _POINTWISE_NUMBERS
-        key = (0 if summed else which, tuple(n for n, _ in columns), tuple(sorted(scalars.items())), levels)
+        key = (0 if summed else which, names, scalars, levels)
         if key not in self._jitted:
             self._jitted[key] = self._compile(*key)
         if not n_sets:
             out = np.asarray(self._jitted[key](np.zeros((1, 0))))[0]
             return out.sum(axis=-1) if summed else out
-        matrix = set_matrix([v for _, v in columns], n_sets)
         out = []
         for i in range(0, n_sets, rows):
             block = matrix[i : i + rows]

@@ -191,14 +191,13 @@ def test_weights_collapsed_onto_the_mode_of_a_ridge_are_refused():
     data, ridge, centre = _ridge_and_centre()
     sample = laplace_importance(ridge, centre, np.random.default_rng(2))
     assert sample is not None and not sample.reliable and sample.width_ratio < 0.65 < MIN_WIDTH_RATIO, sample.width_ratio
-    # the refusal says so (the same seed: the same draws), and diagnose's fit falls back to emcee keeping the reason
-    result, refusal = laplace_fit(ridge, centre, seed=2)
-    assert result is None and refusal == sample.refusal and "collapsed onto the mode" in refusal, refusal
+    # diagnose's fit falls back to emcee and keeps the refusal, which says why (the same seed: the same draws)
     from spacepol.criticism.candidate_fits import fit_for_elpd
     from spacepol.criticism.explain import posterior_quality
 
     fallback = posterior_quality(fit_for_elpd(ridge, centre, seed=2, max_steps=500))
-    assert fallback["engine"] == "emcee" and fallback["laplace_refused"] == refusal
+    refusal = fallback.get("laplace_refused", "")
+    assert fallback["engine"] == "emcee" and refusal == sample.refusal and "collapsed onto the mode" in refusal, refusal
     control = Posterior.build(data, Model.from_string("paper"))
     _, centre = multistart(control, np.random.default_rng(0))
     kept = laplace_importance(control, centre, np.random.default_rng(0))

@@ -135,3 +135,32 @@ def test_a_noise_profile_of_the_wrong_shape_or_sign_is_one_error_naming_it():
         with pytest.raises(ParameterError, match="mueller_noise_profile") as error:
             Likelihood(data, model, observables=["mueller"])
         assert words in str(error.value), str(error.value)
+
+
+def test_pair_differences_are_measured_in_units_of_the_level_where_the_noise_profile_is_one():
+    """A grid of geometries that holds each one's reciprocal, with a noise profile of 1 on rows lit at less than 40 deg
+    and 3 beyond (each element's noise 0.01 x the profile): a pair across the step has a difference of
+    sqrt(1 + 9) x 0.01. Divided by the profile at its two members, the differences measure the level the likelihood
+    multiplies by the profile, 0.01 (within 4 SE of the median's Monte-Carlo error); control: without the profile the
+    same data measure more than 1.5x that."""
+    from spacepol.physics.geometry import Geometry
+
+    angles = np.arange(10.0, 71.0, 10.0)
+    ti, tr, dphi = (a.ravel() for a in np.meshgrid(angles, angles, [-150.0, -90.0, -30.0, 30.0, 90.0, 150.0, 180.0]))
+    g = Geometry(ti, tr, dphi)
+    m = np.asarray(Model.from_string("specular+subsurface").evaluate(TRUTH, g, mueller=True).mueller)
+    profile = np.where(ti < 40.0, 1.0, 3.0)
+    normalised = m / m[0, 0] + 0.01 * profile * np.random.default_rng(4).standard_normal(m.shape)
+    normalised[0, 0] = 1.0
+    data = Dataset(ti, tr, dphi, wavelength_um=np.full(g.size, 0.633))
+    data.mueller, data.brdf, data.source = normalised * m[0, 0], m[0, 0], "render"
+    pairs = reciprocal_pairs(data)
+    assert np.mean(profile[pairs[:, 0]] != profile[pairs[:, 1]]) > 0.3, "the control needs pairs across the step"
+    flat = measure(Likelihood(data, Model.from_string("specular+subsurface"), observables=["mueller"]))
+    data.mueller_noise_profile = np.tile(profile, (3, 1))
+    shaped = measure(Likelihood(data, Model.from_string("specular+subsurface"), observables=["mueller"]))
+    for name in GROUPS:
+        got, se = shaped[name].value / 0.01, shaped[name].standard_error / 0.01
+        assert abs(got - 1) < 4 * se, f"{name}: {got:.3f} +- {se:.3f} of the level; margin {(4 * se - abs(got - 1)) / se:.1f} SE"
+        assert flat[name].value / 0.01 > 1.5, (name, flat[name].value)
+        print(f"{name}: {got:.3f} +- {se:.3f} of the level with the profile, {flat[name].value / 0.01:.3f} without")

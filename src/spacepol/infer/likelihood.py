@@ -170,6 +170,11 @@ class Likelihood:
         """Whether ``channel``'s noise is a nuisance parameter (the file gives no errors for it)."""
         return channel not in self._errors
 
+    def noise_profile(self, channel: str) -> np.ndarray | None:
+        """The factors (N,) on ``channel``'s inferred noise level over the rows (its observable's ``noise_profile``),
+        or None where the level is the same on every row."""
+        return self._profile.get(channel)
+
     def scale(self, channel: str, params: dict | None = None):
         """The channel's noise: the file's errors (N,), or the nuisance level per parameter set (P, 1), times
         the observable's profile over the rows (P, N) where it has one (AoP's 1 / DOP)."""

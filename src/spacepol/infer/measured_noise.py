@@ -95,8 +95,19 @@ def repeated_pairs(data, tolerance_deg: float = 0.01) -> np.ndarray:
     return np.array(pairs, int).reshape(-1, 2)
 
 
+def _in_level_units(likelihood, differences, first, second) -> np.ndarray:
+    """Pair differences over the noise profile of their two members ((rows, channel) each): a difference of numbers
+    whose noise is the level times f1 and f2 has the SD of level x sqrt(f1^2 + f2^2); divided by
+    sqrt((f1^2 + f2^2) / 2) it measures the level where the profile is 1, as differences of equal noise do."""
+    (rows_1, channel_1), (rows_2, channel_2) = first, second
+    f1, f2 = (np.ones(len(rows)) if likelihood.noise_profile(ch) is None else likelihood.noise_profile(ch)[rows]
+              for rows, ch in ((rows_1, channel_1), (rows_2, channel_2)))
+    return np.asarray(differences, float) / np.sqrt(0.5 * (f1**2 + f2**2))
+
+
 def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict]:
-    """{noise parameter: {source: [arrays of differences]}} for every inferred channel of the likelihood."""
+    """{noise parameter: {source: [arrays of differences]}} for every inferred channel of the likelihood, each in
+    units of the level where the channel's noise profile is 1 (``_in_level_units``)."""
     out: dict[str, dict] = {}
     observed = likelihood.observed()
     for channel, y in observed.items():
@@ -107,12 +118,17 @@ def _differences(likelihood, pairs_reciprocal, pairs_repeated) -> dict[str, dict
         sources = out.setdefault(parameter, {})
         if len(pairs_repeated):
             a, b = pairs_repeated.T
-            sources.setdefault("repeated geometries", []).append(np.asarray(owner.residual(channel, y[b], y[a], True), float))
+            d = owner.residual(channel, y[b], y[a], True)
+            sources.setdefault("repeated geometries", []).append(_in_level_units(likelihood, d, (b, channel), (a, channel)))
         if not len(pairs_reciprocal):
             continue
         d = owner.reciprocal_differences(channel, observed, pairs_reciprocal, likelihood.inferred(channel))
-        if d is not None:
-            sources.setdefault("reciprocal pairs", []).append(np.asarray(d, float))
+        if d is None:
+            continue
+        members = owner.reciprocal_members(channel, pairs_reciprocal)
+        if members is not None:
+            d = _in_level_units(likelihood, d, *members)
+        sources.setdefault("reciprocal pairs", []).append(np.asarray(d, float))
     return out
 
 

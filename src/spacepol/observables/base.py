@@ -130,6 +130,12 @@ class Observable:
         noise, in the residual's space; None where reciprocity says nothing about this observable."""
         return None
 
+    def reciprocal_members(self, channel: str, pairs: np.ndarray):
+        """Which measured numbers each of ``reciprocal_differences``' differences takes, in its order: ((rows, channel)
+        of its first member, (rows, channel) of its second); the measured noise divides a difference by the noise
+        profile there (``noise_profile``). None: the differences are taken as they are."""
+        return None
+
     def noise_profile(self, channel: str, data) -> np.ndarray | None:
         """How an inferred noise level varies over the rows: (N,) factors on it, or None for a constant level."""
         return None

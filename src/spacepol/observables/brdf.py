@@ -46,6 +46,11 @@ class BRDF(ColumnObservable):
         a, b = pairs[pairs[:, 0] != pairs[:, 1]].T
         return self.residual(channel, observed[channel][b], observed[channel][a], inferred)
 
+    def reciprocal_members(self, channel, pairs):
+        """(rows b, BRDF) and (rows a, BRDF) of each distinct pair."""
+        a, b = pairs[pairs[:, 0] != pairs[:, 1]].T
+        return (b, channel), (a, channel)
+
     def replicate(self, channel, mu, scale, inferred, rng):
         z = rng.standard_normal(np.shape(mu))
         return mu * np.exp(scale * z) if inferred else mu + scale * z

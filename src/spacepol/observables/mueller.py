@@ -152,6 +152,13 @@ class Mueller(Observable):
         keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
         return observed[channel][b[keep]] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * mirror[a[keep]]
 
+    def reciprocal_members(self, channel, pairs):
+        """(rows b, m_ij) and (rows a, m_ji) of each pair ``reciprocal_differences`` keeps."""
+        i, j = index(channel)
+        a, b = pairs.T
+        keep = (a != b) | (i < j)
+        return (b[keep], channel), (a[keep], f"m{j + 1}{i + 1}")
+
     def noise_parameter(self, channel):
         return NOISE[GROUP_OF[channel]]
 

@@ -43,7 +43,7 @@ class BRDF(ColumnObservable):
 
     def reciprocal_differences(self, channel, observed, pairs, inferred):
         """The BRDF is the same with source and detector swapped (Helmholtz)."""
-        a, b = pairs[pairs[:, 0] != pairs[:, 1]].T
+        (b, _), (a, _) = self.reciprocal_members(channel, pairs)
         return self.residual(channel, observed[channel][b], observed[channel][a], inferred)
 
     def reciprocal_members(self, channel, pairs):

@@ -147,16 +147,14 @@ class Mueller(Observable):
     def reciprocal_differences(self, channel, observed, pairs, inferred):
         """m_ij(r -> i) - q_i q_j m_ji(i -> r): reciprocity transposes the matrix (Q = diag(1, 1, -1, 1))."""
         i, j = index(channel)
-        mirror = observed[f"m{j + 1}{i + 1}"] if i != j else observed[channel]
-        a, b = pairs.T
-        keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
-        return observed[channel][b[keep]] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * mirror[a[keep]]
+        (rows_b, _), (rows_a, mirror) = self.reciprocal_members(channel, pairs)
+        return observed[channel][rows_b] - RECIPROCITY_SIGNS[i] * RECIPROCITY_SIGNS[j] * observed[mirror][rows_a]
 
     def reciprocal_members(self, channel, pairs):
-        """(rows b, m_ij) and (rows a, m_ji) of each pair ``reciprocal_differences`` keeps."""
+        """(rows b, m_ij) and (rows a, m_ji) of each pair (a, b) whose difference says something."""
         i, j = index(channel)
         a, b = pairs.T
-        keep = (a != b) | (i < j)
+        keep = (a != b) | (i < j)  # a self-pair constrains only the off-diagonal elements, each pair once
         return (b[keep], channel), (a[keep], f"m{j + 1}{i + 1}")
 
     def noise_parameter(self, channel):

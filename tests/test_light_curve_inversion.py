@@ -89,8 +89,8 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     """The default run's version of the test above: the target file gives the true attitude, so only the material's
     parameters are sampled. The true material first by ELPD-LOO and by a Bayes factor above e^10 against kapton (the
     paired SE of an ELPD difference carried by a few badly missed points can be as large as the difference itself,
-    so the SE is not asserted here), its parameters' 99 % intervals hold the truth; the report's files exist; the same command run again reads the materials already fitted, and a saved fit is used only
-    for its own inputs."""
+    so the SE is not asserted here), its parameters' 99 % intervals hold the truth; the report's files exist; the
+    same command run again reads the materials already fitted, and a saved fit is used only for its own inputs."""
     folder, csv, _, truth, _ = rendered
     attitude = Attitude(truth["yaw_deg"], truth["pitch_deg"], truth["roll_deg"])
     known = box(folder / "known.toml", None, attitude)

@@ -99,9 +99,11 @@ def _in_level_units(likelihood, differences, first, second) -> np.ndarray:
     """Pair differences over the noise profile of their two members ((rows, channel) each): a difference of numbers
     whose noise is the level times f1 and f2 has the SD of level x sqrt(f1^2 + f2^2); divided by
     sqrt((f1^2 + f2^2) / 2) it measures the level where the profile is 1, as differences of equal noise do."""
-    (rows_1, channel_1), (rows_2, channel_2) = first, second
-    f1, f2 = (np.ones(len(rows)) if likelihood.noise_profile(ch) is None else likelihood.noise_profile(ch)[rows]
-              for rows, ch in ((rows_1, channel_1), (rows_2, channel_2)))
+    def profile_at(rows, channel):
+        profile = likelihood.noise_profile(channel)
+        return np.ones(len(rows)) if profile is None else profile[rows]
+
+    f1, f2 = profile_at(*first), profile_at(*second)
     return np.asarray(differences, float) / np.sqrt(0.5 * (f1**2 + f2**2))
 
 

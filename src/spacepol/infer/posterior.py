@@ -129,12 +129,11 @@ class Posterior:
     def summed_log_likelihood(self, theta) -> np.ndarray:
         """The likelihood's sum per row of theta (W, D), every row evaluated (``log_likelihood`` masks)."""
         theta = np.atleast_2d(theta)
-        of_matrix = getattr(self.likelihood, "of_matrix", None)
-        if of_matrix is None or theta.shape[1] != self.priors.ndim:
+        if theta.shape[1] != self.priors.ndim:
             return self.likelihood.total(self.priors.to_params(theta))
         # theta's columns are the free parameters in order: the compiled call's matrix as it is (a sampler's step)
         held = tuple(sorted((n, float(v)) for n, v in self.priors.fixed.items()))
-        return of_matrix(1, tuple(self.priors.names), held, np.asarray(theta, float))
+        return self.likelihood.of_matrix(1, tuple(self.priors.names), held, np.asarray(theta, float))
 
     def __call__(self, theta):
         return self.log_prob(theta)

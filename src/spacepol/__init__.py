@@ -20,7 +20,7 @@ _API = {
     "diagnose": "api", "Diagnosis": "api", "calibrate": "api", "Calibration": "infer.calibration", "ladder": "api", "Ladder": "api", "design": "api", "Design": "api",
     "Result": "infer.result", "Diagnostics": "infer.result", "Fit": "infer.result",
     "Dataset": "io.dataset", "Model": "physics.model", "Geometry": "physics.geometry",
-    "SpacepolError": "errors", "observe": "api", "synth_pass": "api", "invert_lightcurve": "api", "LightCurve": "io.light_curve", "frame": "api", "optimize": "api", "compare": "api", "Comparison": "api",
+    "SpacepolError": "errors", "SamplerStalled": "errors", "observe": "api", "synth_pass": "api", "invert_lightcurve": "api", "LightCurve": "io.light_curve", "frame": "api", "optimize": "api", "compare": "api", "Comparison": "api",
 }
 
 __all__ = ["configure_process", "__version__", *_API]

@@ -281,7 +281,7 @@ def main(argv=None) -> int:
     # optimizers) on the calling thread
     configure_process(small_calls=True)
     from . import commands
-    from .errors import SpacepolError
+    from .errors import SamplerStalled, SpacepolError
 
     try:
         for spec in args.effect + getattr(args, "effect_after", []):
@@ -292,6 +292,9 @@ def main(argv=None) -> int:
     except SpacepolError as exc:
         print(f"invert-mcmc: error: {exc}", file=sys.stderr)
         return 2
+    except SamplerStalled as exc:
+        print(f"invert-mcmc: {exc}", file=sys.stderr)
+        return 1
     except BrokenPipeError:  # e.g. `invert-mcmc effects | head`
         sys.stderr.close()
         return 0

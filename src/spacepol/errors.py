@@ -29,3 +29,8 @@ class UnknownNameError(SpacepolError):
 
 class ParameterError(SpacepolError):
     """An impossible or inconsistent parameter value or prior."""
+
+
+class SamplerStalled(Exception):
+    """A sampler stopped making progress and was stopped (``infer.engines.stall_guard``): not the input's fault, so
+    not a SpacepolError; the CLI prints its one line and exits with status 1."""

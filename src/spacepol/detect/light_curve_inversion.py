@@ -31,6 +31,9 @@ EFFECTIVE_DRAWS = 2000  # nested sampling stops once its weighted points are wor
 # shell, and its weighted points gain almost no effective draws per call (white paint on a solar-glass render: 1
 # effective draw after 8,000 calls)
 DRAWS_FOR_LOO = 2000
+# an exploration that stalls (``infer.engines.stall_guard``) starts again from the prior with the next seed of the
+# material's stream, at most this many times
+STALL_RESTARTS = 2
 BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
 
 
@@ -64,7 +67,8 @@ class MaterialFit:
     """One candidate's posterior: ``names``, ``samples`` (equally weighted draws, D), the ELPD-LOO record (``loo``:
     elpd_loo, elpd_loo_se, p_loo, pareto_k, pointwise), nested sampling's ``log_evidence`` (ln Z), its weighted
     points' ``effective_draws`` and its ``likelihood_calls``, the posterior-predictive bands {observable: (3, T)
-    5/50/95 %}, and ``seconds``."""
+    5/50/95 %}, ``seconds``, the ``restarts`` a stalled exploration took (``STALL_RESTARTS``), and an attitude mode
+    the draws miss (``attitude_modes.unsampled_mode``: its record, or None)."""
 
     material: str
     description: str
@@ -76,6 +80,8 @@ class MaterialFit:
     likelihood_calls: int
     bands: dict
     seconds: float
+    restarts: int = 0
+    unsampled_attitude: dict | None = None
 
     def save(self, path, key: str) -> None:
         """This fit in one .npz file (written whole or not at all), labelled with ``key`` (what it was fitted to)."""
@@ -84,7 +90,8 @@ class MaterialFit:
         scalars = {"material": self.material, "description": self.description, "names": self.names, "key": key,
                    "log_evidence": self.log_evidence, "effective_draws": self.effective_draws,
                    "likelihood_calls": self.likelihood_calls,
-                   "seconds": self.seconds, "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
+                   "seconds": self.seconds, "restarts": self.restarts, "unsampled_attitude": self.unsampled_attitude,
+                   "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
         arrays = {"samples": self.samples, "pointwise": self.loo["pointwise"], "pareto_k": self.loo["pareto_k"]}
         arrays |= {f"band_{k}": v for k, v in self.bands.items()}
         with atomic_path(path) as tmp:
@@ -103,7 +110,8 @@ class MaterialFit:
                 bands = {k.removeprefix("band_"): f[k] for k in f.files if k.startswith("band_")}
                 record = scalars["loo"] | {"pointwise": f["pointwise"], "pareto_k": f["pareto_k"]}
                 return cls(scalars["material"], scalars["description"], scalars["names"], f["samples"], record,
-                           scalars["log_evidence"], scalars["effective_draws"], scalars["likelihood_calls"], bands, scalars["seconds"])
+                           scalars["log_evidence"], scalars["effective_draws"], scalars["likelihood_calls"], bands, scalars["seconds"],
+                           scalars.get("restarts", 0), scalars.get("unsampled_attitude"))
         except (OSError, ValueError, KeyError, EOFError):
             return None
 
@@ -119,12 +127,16 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode."""
     from nautilus import Sampler
 
+    from ..errors import SamplerStalled
     from ..infer.engines.nested import explore_then_sample, kish_draws, replicate_draws
+    from ..infer.engines.stall_guard import CallClock
 
     start = time.perf_counter()
     calls = {"sets": 0, "next": 20000}
+    clock = CallClock()
 
     def log_likelihood(theta):
+        clock.tick()
         theta = np.atleast_2d(theta)
         out = pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1)
         calls["sets"] += len(theta)
@@ -137,9 +149,16 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     def rescale(u):
         return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
 
-    sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live, n_networks=1, vectorized=True,
-                      seed=int(rng.integers(2**31)))
-    explore_then_sample(sampler, EFFECTIVE_DRAWS)
+    for restarts in range(STALL_RESTARTS + 1):
+        sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live, n_networks=1, vectorized=True,
+                          seed=int(rng.integers(2**31)))
+        try:
+            explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, f"material {model.material.name}")
+            break
+        except SamplerStalled as stalled:
+            if restarts == STALL_RESTARTS:
+                raise SamplerStalled(f"{stalled} (the exploration stalled {restarts + 1} times from different seeds)") from None
+            print(f"  {model.material.name}: {stalled}; starting again from the prior with another seed", file=sys.stderr)
     points, log_w, _ = sampler.posterior()
     effective = kish_draws(log_w)
     kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]
@@ -148,9 +167,28 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
+    missed = _unsampled_attitude(model, curve, observables, kept, ll.sum(axis=1) + model.log_prior(kept))
+    if progress and missed is not None:
+        print(f"  {model.material.name}: {missed['finding']}", file=sys.stderr)
     return MaterialFit(model.material.name, model.material.description, list(model.names), kept, record,
                        float(sampler.log_z), effective, int(sampler.n_like), _bands(model, curve, kept[:200], rng),
-                       time.perf_counter() - start)
+                       time.perf_counter() - start, restarts, missed)
+
+
+def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], draws: np.ndarray,
+                        draws_log_posterior: np.ndarray) -> dict | None:
+    """``attitude_modes.unsampled_mode`` of a fit's draws (None where the attitude is known)."""
+    from .attitude_modes import unsampled_mode
+
+    if model.attitude is not None:
+        return None
+
+    def log_posterior(theta):
+        return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
+
+    mode = unsampled_mode(log_posterior, list(model.names), list(ANGLES), [p.bounds for p in model.priors], draws,
+                          draws_log_posterior)
+    return None if mode is None else mode.to_json()
 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:
@@ -240,6 +278,7 @@ class LightCurveInversion:
                                             "log_evidence": f.log_evidence, "effective_draws": f.effective_draws,
                                             "likelihood_calls": f.likelihood_calls,
                                             "p_loo": f.loo["p_loo"], "pareto_k_max": float(np.max(f.loo["pareto_k"])),
-                                            "seconds": f.seconds} for f in self.fits},
+                                            "seconds": f.seconds, "restarts": f.restarts,
+                                            "unsampled_attitude": f.unsampled_attitude} for f in self.fits},
                 "times_utc": [t.strftime("%Y-%m-%dT%H:%M:%SZ") for t in self.curve.times_utc],
                 "assumptions": self.assumptions}

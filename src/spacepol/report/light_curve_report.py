@@ -89,6 +89,13 @@ def write_light_curve_report(inversion, out: Path) -> dict:
         verdict += (f" Few effective draws (under {FEW_EFFECTIVE_DRAWS}) for {', '.join(rough)}: the sampler's budget ran "
                     "out on a posterior far narrower than its last shell, so those posteriors and ELPD-LOO are rough; "
                     "ln Z is still an estimate.")
+    restarted = [f"{m} ({c['restarts']}x)" for m, c in content["candidates"].items() if c.get("restarts")]
+    if restarted:
+        verdict += (f" Nested sampling's exploration stalled and started again from the prior with another seed for "
+                    f"{', '.join(restarted)} (its neural bound rejected nearly every point drawn).")
+    missed = content["candidates"][content["best"]].get("unsampled_attitude")
+    if missed:
+        verdict += f" For {content['best']}, {missed['finding']}."
     loose = [k for k, v in content["attitude"].items() if v["q95"] - v["q05"] > LOOSE_ATTITUDE_DEG]
     if loose:
         verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "

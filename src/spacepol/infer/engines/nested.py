@@ -18,6 +18,7 @@ from scipy.special import logsumexp
 
 from ..engine_result import EngineResult
 from .base import SAMPLER, Engine
+from .stall_guard import CallClock, stall_guard
 
 
 def replicate_draws(points, log_w, rng: np.random.Generator, size: int) -> np.ndarray:
@@ -37,14 +38,18 @@ def kish_draws(log_w) -> float:
 SAMPLING_CALLS_PER_LIVE_POINT = 100
 
 
-def explore_then_sample(sampler, effective_draws: int, calls_per_live_point: int = SAMPLING_CALLS_PER_LIVE_POINT) -> bool:
+def explore_then_sample(sampler, effective_draws: int, clock: CallClock, what: str,
+                        calls_per_live_point: int = SAMPLING_CALLS_PER_LIVE_POINT) -> bool:
     """Run a nautilus ``sampler``'s exploration to its end, then sample its shells until the points are worth
     ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent; whether
     the draws were reached. The cap matters where a posterior is far narrower than the last shell: there the points
-    gain almost no effective draws per call, and an uncapped run goes on for hours."""
-    sampler.run(n_eff=0, discard_exploration=True, verbose=False)
-    sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False,
-                n_like_max=sampler.n_like + calls_per_live_point * sampler.n_live)
+    gain almost no effective draws per call, and an uncapped run goes on for hours. ``clock``: ticked by the
+    sampler's likelihood; a run that stops calling it stops with ``SamplerStalled`` naming ``what``
+    (``stall_guard``)."""
+    with stall_guard(clock, what):
+        sampler.run(n_eff=0, discard_exploration=True, verbose=False)
+        sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False,
+                    n_like_max=sampler.n_like + calls_per_live_point * sampler.n_live)
     return sampler.n_eff >= effective_draws
 
 
@@ -66,8 +71,10 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
 
     start = time.perf_counter()
     priors = posterior.priors
+    clock = CallClock()
 
     def log_likelihood(theta):
+        clock.tick()
         value = posterior.log_likelihood(np.atleast_2d(theta))
         return np.where(np.isfinite(value), value, -1e300)  # nautilus needs finite numbers
 
@@ -75,7 +82,7 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
     for r in range(replicates):
         sampler = Sampler(priors.rescale, log_likelihood, n_dim=priors.ndim, n_live=live, n_networks=networks,
                           vectorized=True, seed=int(rng.integers(2**31)))
-        explore_then_sample(sampler, effective_draws)
+        explore_then_sample(sampler, effective_draws, clock, f"replicate {r + 1} of {posterior.likelihood.model.name}")
         points, log_w, log_l = sampler.posterior()
         effective.append(kish_draws(log_w))
         log_z.append(float(sampler.log_z))

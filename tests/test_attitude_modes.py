@@ -32,7 +32,7 @@ def test_a_mirrored_mode_the_draws_miss_is_found(second_below):
     rng = np.random.default_rng(3)
     log_posterior = _density(second_below)
     draws = _draws(rng, [FIRST])  # nested sampling kept the first mode only
-    mode = unsampled_mode(log_posterior, NAMES, ANGLES, BOUNDS, draws, log_posterior(draws))
+    mode = unsampled_mode(log_posterior, NAMES, BOUNDS, draws, log_posterior(draws), np.random.default_rng(1))
     assert mode is not None
     found = np.array([mode.attitude[a] for a in ANGLES])
     assert np.allclose(found, SECOND[1:], atol=0.05), found
@@ -44,14 +44,14 @@ def test_nothing_is_named_where_the_draws_hold_both_modes_or_the_second_is_far_b
     rng = np.random.default_rng(4)
     both = _density(1.1)
     draws = _draws(rng, [FIRST, SECOND])
-    assert unsampled_mode(both, NAMES, ANGLES, BOUNDS, draws, both(draws)) is None
+    assert unsampled_mode(both, NAMES, BOUNDS, draws, both(draws), np.random.default_rng(2)) is None
     low = _density(MARGIN + 10.0)  # holds e^-13 of the first's mass: not a mode worth naming
     draws = _draws(rng, [FIRST])
-    assert unsampled_mode(low, NAMES, ANGLES, BOUNDS, draws, low(draws)) is None
+    assert unsampled_mode(low, NAMES, BOUNDS, draws, low(draws), np.random.default_rng(3)) is None
 
 
 def test_a_known_attitude_has_nothing_to_check():
     rng = np.random.default_rng(5)
     draws = 1.5 + 0.01 * rng.standard_normal((100, 1))
-    assert unsampled_mode(lambda t: -0.5 * ((t[:, 0] - 1.5) / 0.01) ** 2, ["n"], ANGLES, [(1.0, 2.0)], draws,
-                          np.zeros(100)) is None
+    assert unsampled_mode(lambda t: -0.5 * ((t[:, 0] - 1.5) / 0.01) ** 2, ["n"], [(1.0, 2.0)], draws,
+                          np.zeros(100), np.random.default_rng(4)) is None

@@ -1,26 +1,27 @@
 """An attitude the posterior draws left out: a second optimum, as good as the best draw, outside every draw.
 
-A box whose faces look alike under a turn has more than one attitude that makes the same light curve. The one
-found most often: the box mirrored through the orbit plane, (yaw, pitch, roll) -> (-yaw, pitch, -roll), which swaps
-port and starboard (S R(yaw, pitch, roll) S = R(-yaw, pitch, -roll), S = diag(1, -1, 1)); the sun and the site are
-not mirrored, so the second optimum lies near that point. Nested sampling with few live points can keep one of two
-such modes. The check: from the best draw with each combination of the angles' signs flipped, a bounded local
-search (Powell) of the log posterior; an optimum within ``MARGIN`` of the best draw that lies more than
-``SEPARATED`` of the draws' own SD from each draw in some angle is a mode the draws miss.
+A box whose faces look alike under a turn has more than one attitude that makes the same light curve; the one met
+most: the box mirrored through the orbit plane, (yaw, pitch, roll) -> (-yaw, pitch, -roll), which swaps port and
+starboard (S R(yaw, pitch, roll) S = R(-yaw, pitch, -roll), S = diag(1, -1, 1)). The sun and the site are not
+mirrored, so the second optimum lies near that point, in a basin as narrow as the light curve's signal-to-noise
+makes it: a local search from the mirrored point stops in one of many shallow optima around it. The check: differential
+evolution over the material's prior and the angles within ``BOX_DEG`` of the mirrored best draw; an optimum within
+``MARGIN`` of the best draw's log posterior, more than ``SEPARATED`` of the draws' own SD from each draw in some
+angle, is a mode the draws miss. Nested sampling with few live points can keep one of two such modes.
 """
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import differential_evolution
 
 MARGIN = 3.0  # log posterior below the best draw within which a second mode holds >= ~5 % of the first's mass
 SEPARATED = 5.0  # draws' SDs (at least MIN_SD_DEG) between the optimum and the nearest draw, in its farthest angle
 MIN_SD_DEG = 0.1
-EVALUATIONS = 300  # per local search
+BOX_DEG = 15.0  # the search box's half width about the mirrored attitude
+MIRROR = {"yaw_deg": -1.0, "pitch_deg": 1.0, "roll_deg": -1.0}
 
 
 @dataclass(frozen=True)
@@ -40,50 +41,37 @@ class AttitudeMode:
                 "finding": self.finding}
 
 
-def _flipped_starts(best: np.ndarray, columns: list[int], bounds: np.ndarray) -> list[np.ndarray]:
-    starts = []
-    for signs in itertools.product((1.0, -1.0), repeat=len(columns)):
-        if all(s > 0 for s in signs):
-            continue
-        start = best.copy()
-        start[columns] *= signs
-        starts.append(np.clip(start, bounds[:, 0], bounds[:, 1]))
-    return starts
-
-
-def unsampled_mode(log_posterior, names: list[str], angles: list[str], bounds, draws: np.ndarray,
-                   draws_log_posterior: np.ndarray) -> AttitudeMode | None:
-    """The best attitude optimum outside ``draws`` (S, D) within ``MARGIN`` of their best, or None.
-    ``log_posterior``: rows (S, D) -> (S,); ``angles``: the names of the attitude columns; ``bounds`` (D, 2)."""
-    columns = [names.index(a) for a in angles if a in names]
-    if not columns:
+def unsampled_mode(log_posterior, names: list[str], bounds, draws: np.ndarray, draws_log_posterior: np.ndarray,
+                   rng: np.random.Generator) -> AttitudeMode | None:
+    """The mirrored attitude's optimum where it lies outside ``draws`` (S, D) within ``MARGIN`` of their best, or
+    None (also where the attitude is not among ``names``). ``log_posterior``: rows (S, D) -> (S,); ``bounds`` (D, 2)."""
+    if not all(a in names for a in MIRROR):
         return None
+    columns = [names.index(a) for a in MIRROR]
     bounds = np.asarray(bounds, float)
     best_index = int(np.argmax(draws_log_posterior))
     best, best_value = draws[best_index], float(draws_log_posterior[best_index])
+    box = bounds.copy()
+    for j, sign in zip(columns, MIRROR.values()):
+        centre = sign * best[j]
+        box[j] = max(bounds[j, 0], centre - BOX_DEG), min(bounds[j, 1], centre + BOX_DEG)
+
+    def negative(x):  # DE's vectorised call: x (D, S)
+        value = log_posterior(np.asarray(x, float).T)
+        return np.where(np.isfinite(value), -value, 1e300)
+
+    res = differential_evolution(negative, box, popsize=20, maxiter=300, tol=1e-8, vectorized=True, updating="deferred",
+                                 polish=True, rng=np.random.default_rng(rng.integers(2**63)))
+    value, theta = -float(np.atleast_1d(res.fun)[0]), np.asarray(res.x, float)
     sd = np.maximum(draws[:, columns].std(axis=0), MIN_SD_DEG)
-
-    def negative(x):
-        value = float(log_posterior(np.asarray(x, float)[None, :])[0])
-        return -value if np.isfinite(value) else 1e300
-
-    found = None
-    for start in _flipped_starts(best, columns, bounds):
-        res = minimize(negative, start, method="Powell", bounds=bounds, options={"maxfev": EVALUATIONS, "xtol": 1e-3})
-        value = -float(res.fun)
-        if value < best_value - MARGIN:
-            continue
-        distance = np.min(np.max(np.abs(draws[:, columns] - res.x[columns]) / sd, axis=1))
-        if distance > SEPARATED and (found is None or value > found[0]):
-            found = (value, res.x)
-    if found is None:
+    distance = np.min(np.max(np.abs(draws[:, columns] - theta[columns]) / sd, axis=1))
+    if value < best_value - MARGIN or distance <= SEPARATED:
         return None
-    value, theta = found
     attitude = {names[j]: float(theta[j]) for j in columns}
     at = ", ".join(f"{k.removesuffix('_deg')} {v:.1f}" for k, v in attitude.items())
     drawn = ", ".join(f"{names[j].removesuffix('_deg')} {best[j]:.1f}" for j in columns)
     finding = (f"a second attitude ({at} deg) fits {'as well as' if value <= best_value else 'better than'} the best "
-               f"draw ({drawn} deg; log posterior {value - best_value:+.1f}) and lies outside every draw: the light "
-               "curve does not tell the two apart, and the attitude's intervals hold one of them only (more --live "
-               "points sample both)")
+               f"draw ({drawn} deg; log posterior {value - best_value:+.1f}) and lies outside every draw: the draws "
+               "hold one of two attitudes only, so the attitude's intervals may exclude the truth (more --live points "
+               "sample both)")
     return AttitudeMode(attitude, theta, value, best_value - value, finding)

@@ -167,7 +167,7 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
-    missed = _unsampled_attitude(model, curve, observables, kept, ll.sum(axis=1) + model.log_prior(kept))
+    missed = _unsampled_attitude(model, curve, observables, kept, ll.sum(axis=1) + model.log_prior(kept), rng)
     if progress and missed is not None:
         print(f"  {model.material.name}: {missed['finding']}", file=sys.stderr)
     return MaterialFit(model.material.name, model.material.description, list(model.names), kept, record,
@@ -176,7 +176,7 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
 
 
 def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], draws: np.ndarray,
-                        draws_log_posterior: np.ndarray) -> dict | None:
+                        draws_log_posterior: np.ndarray, rng: np.random.Generator) -> dict | None:
     """``attitude_modes.unsampled_mode`` of a fit's draws (None where the attitude is known)."""
     from .attitude_modes import unsampled_mode
 
@@ -186,8 +186,8 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
     def log_posterior(theta):
         return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
 
-    mode = unsampled_mode(log_posterior, list(model.names), list(ANGLES), [p.bounds for p in model.priors], draws,
-                          draws_log_posterior)
+    mode = unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws, draws_log_posterior,
+                          rng)
     return None if mode is None else mode.to_json()
 
 

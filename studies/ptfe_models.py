@@ -200,6 +200,7 @@ def fit(data, spec: str, seed: int, method: str, max_steps: int, noise: dict, sc
     record = {
         "model": spec, "free_parameters": post.ndim, "max_log_posterior": best, "engine": s.diagnostics["engine"],
         "laplace_refused": "" if method != "laplace" else refusal, "rhat_max": s.diagnostics["rhat_max"],
+        "pareto_k": s.diagnostics.get("pareto_k"), "sd_growth_max": s.diagnostics.get("sd_growth_max"),
         "elpd_loo": s.fit["elpd_loo"], "elpd_loo_se": s.fit["elpd_loo_se"],
         "inferred_noise": {k: v["median"] for k, v in s.parameters.items() if k.startswith("sigma_m_")},
         "noise_factor": noise_factors(data, noise, s.parameters),

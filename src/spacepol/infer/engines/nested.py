@@ -46,7 +46,7 @@ def explore_then_sample(sampler, effective_draws: int, clock: CallClock, what: s
     gain almost no effective draws per call, and an uncapped run goes on for hours. ``clock``: ticked by the
     sampler's likelihood; a run that stops calling it stops with ``SamplerStalled`` naming ``what``
     (``stall_guard``)."""
-    with stall_guard(clock, what):
+    with stall_guard(clock, what, sampler):
         sampler.run(n_eff=0, discard_exploration=True, verbose=False)
         sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False,
                     n_like_max=sampler.n_like + calls_per_live_point * sampler.n_live)

@@ -1,11 +1,12 @@
-"""A watchdog for nested sampling's exploration: a run that stops calling its likelihood is stopped with a clear error.
+"""A watchdog for nested sampling's exploration: a run that stops making progress is stopped with a clear error.
 
 nautilus draws new points from each shell by rejection: points from the shell's ellipsoids, kept where its neural
 network says they lie inside. Where the network accepts almost nothing of the ellipsoids (a multimodal attitude
-posterior of a light curve is one case; upstream: johannesulf/nautilus issues 26 and 28) that loop runs for hours
-and calls no likelihood, so neither a call budget nor nautilus' own ``timeout`` (checked between batches) stops it.
-A healthy run calls its likelihood several times a second, so ``STALL_SECONDS`` without a call is a stall. The
-watchdog thread then raises ``SamplerStalled`` in the sampling thread (``PyThreadState_SetAsyncExc``: delivered at
+posterior of a light curve; upstream: johannesulf/nautilus issues 26 and 28) that loop runs for hours, calling the
+likelihood rarely or never, so neither a call budget nor nautilus' own ``timeout`` (checked between batches) stops
+it. Two signs, each far from a healthy run: no likelihood call for ``STALL_SECONDS``, or the newest shell's bound
+keeping fewer than ``MIN_ACCEPTANCE`` of ``MIN_DRAWS`` or more points drawn (a healthy shell keeps 1-50 %). The
+watchdog thread then raises ``SamplerStalled`` in the sampling thread (``PyThreadState_SetAsyncExc``, delivered at
 the next Python instruction of the rejection loop, which is Python code).
 """
 
@@ -20,6 +21,9 @@ from ...errors import SamplerStalled
 
 # seconds without a likelihood call that make a stall: ~100x the longest gap of a healthy run
 STALL_SECONDS = 120.0
+# a shell's bound that has drawn MIN_DRAWS points and kept under MIN_ACCEPTANCE of them: a stall in counts, not time
+MIN_DRAWS = 20_000_000
+MIN_ACCEPTANCE = 1e-4
 
 
 class CallClock:
@@ -39,12 +43,24 @@ def _raise_in(thread_id: int, exception: type[BaseException]) -> None:
     ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(thread_id), ctypes.py_object(exception))
 
 
+def starved(sampler) -> str:
+    """Why ``sampler``'s (a nautilus Sampler's) newest shell counts as stalled, in words; "" where it does not."""
+    bounds = getattr(sampler, "bounds", None)
+    if not bounds:
+        return ""
+    drawn, rejected = getattr(bounds[-1], "n_sample", 0), getattr(bounds[-1], "n_reject", 0)
+    if drawn < MIN_DRAWS or drawn - rejected >= MIN_ACCEPTANCE * drawn:
+        return ""
+    return f"its newest shell kept {drawn - rejected} of {drawn:.3g} points drawn"
+
+
 @contextmanager
-def stall_guard(clock: CallClock, what: str, seconds: float = STALL_SECONDS, poll_seconds: float = 0.5):
-    """Run the block under a watchdog: where ``clock`` records no likelihood call for ``seconds``, the block stops
-    with ``SamplerStalled`` naming ``what`` and how many calls it had made."""
+def stall_guard(clock: CallClock, what: str, sampler=None, seconds: float = STALL_SECONDS, poll_seconds: float = 0.5):
+    """Run the block under a watchdog: where ``clock`` records no likelihood call for ``seconds``, or ``sampler``'s
+    newest shell keeps almost none of the points it draws (``starved``), the block stops with ``SamplerStalled``
+    naming ``what`` and the sign."""
     target = threading.get_ident()
-    lock, state = threading.Lock(), {"active": True, "fired": False}
+    lock, state = threading.Lock(), {"active": True, "sign": ""}
 
     def watch():
         while True:
@@ -52,8 +68,10 @@ def stall_guard(clock: CallClock, what: str, seconds: float = STALL_SECONDS, pol
             with lock:
                 if not state["active"]:
                     return
-                if time.monotonic() - clock.last > seconds:
-                    state["fired"] = True
+                idle = time.monotonic() - clock.last
+                sign = f"no likelihood call for {idle:.0f} s" if idle > seconds else starved(sampler)
+                if sign:
+                    state["sign"] = sign
                     _raise_in(target, SamplerStalled)
                     return
 
@@ -67,11 +85,11 @@ def stall_guard(clock: CallClock, what: str, seconds: float = STALL_SECONDS, pol
             with lock:
                 state["active"] = False
     except SamplerStalled:
-        if not state["fired"]:
+        if not state["sign"]:
             raise
         raise SamplerStalled(
-            f"{what}: nested sampling stalled: no likelihood call for {seconds:.0f} s after {clock.calls} calls "
-            "(nautilus drawing new points from bounds its neural network rejects nearly all of); try another --seed "
-            "or more --live points") from None
+            f"{what}: nested sampling stalled after {clock.calls} likelihood calls: {state['sign']} (nautilus drawing "
+            "new points from bounds its neural network rejects nearly all of); try another --seed or more --live "
+            "points") from None
     finally:
         watchdog.join()

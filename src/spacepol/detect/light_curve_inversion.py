@@ -31,8 +31,9 @@ EFFECTIVE_DRAWS = 2000  # nested sampling stops once its weighted points are wor
 # shell, and its weighted points gain almost no effective draws per call (white paint on a solar-glass render: 1
 # effective draw after 8,000 calls)
 DRAWS_FOR_LOO = 2000
-# an exploration that stalls (``infer.engines.stall_guard``) starts again from the prior with the next seed of the
-# material's stream, at most this many times
+# an exploration that stalls (``infer.engines.stall_guard``) starts again from the prior with twice the live points
+# (and the next seed of the material's stream), at most this many times: on a calibration render of smooth solar glass
+# (nearly all of its light in glints) 100 live points stalled from two seeds, where 200 finished
 STALL_RESTARTS = 2
 BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
 
@@ -150,15 +151,17 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
         return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
 
     for restarts in range(STALL_RESTARTS + 1):
-        sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live, n_networks=1, vectorized=True,
-                          seed=int(rng.integers(2**31)))
+        sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live * 2**restarts, n_networks=1,
+                          vectorized=True, seed=int(rng.integers(2**31)))
         try:
             explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, f"material {model.material.name}")
             break
         except SamplerStalled as stalled:
             if restarts == STALL_RESTARTS:
-                raise SamplerStalled(f"{stalled} (the exploration stalled {restarts + 1} times from different seeds)") from None
-            print(f"  {model.material.name}: {stalled}; starting again from the prior with another seed", file=sys.stderr)
+                raise SamplerStalled(f"{stalled} (it stalled {restarts + 1} times, with up to {live * 2**restarts} live "
+                                     "points)") from None
+            print(f"  {model.material.name}: {stalled}; starting again from the prior with {2 * live * 2**restarts} live "
+                  "points", file=sys.stderr)
     points, log_w, _ = sampler.posterior()
     effective = kish_draws(log_w)
     kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]

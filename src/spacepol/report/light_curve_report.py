@@ -91,8 +91,8 @@ def write_light_curve_report(inversion, out: Path) -> dict:
                     "ln Z is still an estimate.")
     restarted = [f"{m} ({c['restarts']}x)" for m, c in content["candidates"].items() if c.get("restarts")]
     if restarted:
-        verdict += (f" Nested sampling's exploration stalled and started again from the prior with another seed for "
-                    f"{', '.join(restarted)} (its neural bound rejected nearly every point drawn).")
+        verdict += (f" Nested sampling's exploration stalled and started again from the prior with twice the live "
+                    f"points for {', '.join(restarted)} (its neural bound rejected nearly every point drawn).")
     missed = content["candidates"][content["best"]].get("unsampled_attitude")
     if missed:
         verdict += f" For {content['best']}, {missed['finding']}."

@@ -89,7 +89,8 @@ def write_light_curve_report(inversion, out: Path) -> dict:
         verdict += (f" Few effective draws (under {FEW_EFFECTIVE_DRAWS}) for {', '.join(rough)}: the sampler's budget ran "
                     "out on a posterior far narrower than its last shell, so those posteriors and ELPD-LOO are rough; "
                     "ln Z is still an estimate.")
-    restarted = [f"{m} ({c['restarts']}x)" for m, c in content["candidates"].items() if c.get("restarts")]
+    restarted = [f"{m} ({c['restarts']} restart{'s' if c['restarts'] > 1 else ''})" for m, c in content["candidates"].items()
+                 if c.get("restarts")]
     if restarted:
         verdict += (f" Nested sampling's exploration stalled and started again from the prior with twice the live "
                     f"points for {', '.join(restarted)} (its neural bound rejected nearly every point drawn).")

@@ -44,7 +44,7 @@ def explore_then_sample(sampler, effective_draws: int, clock: CallClock, what: s
     ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent; whether
     the draws were reached. The cap matters where a posterior is far narrower than the last shell: there the points
     gain almost no effective draws per call, and an uncapped run goes on for hours. ``clock``: ticked by the
-    sampler's likelihood; a run that stops calling it stops with ``SamplerStalled`` naming ``what``
+    sampler's likelihood; a run that stops making progress stops with ``SamplerStalled`` naming ``what``
     (``stall_guard``)."""
     with stall_guard(clock, what, sampler):
         sampler.run(n_eff=0, discard_exploration=True, verbose=False)

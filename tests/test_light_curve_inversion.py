@@ -117,6 +117,17 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "kapton" else f for f in inversion.fits])
     write_light_curve_report(rough, folder / "rough")
     assert "Few effective draws (under 200) for kapton (3)" in (folder / "rough" / "report.html").read_text()
+    assert "restart" not in (folder / "fit" / "report.html").read_text()
+    # a restarted exploration and an attitude the draws miss are named too, and survive a save and a load
+    missed = {"attitude": {"yaw_deg": -40.0, "pitch_deg": 5.0, "roll_deg": 2.0}, "log_posterior": -10.0,
+              "below_best": -1.5, "finding": "a second attitude (yaw -40.0, pitch 5.0, roll 2.0 deg) fits better"}
+    marked = replace(best, restarts=1, unsampled_attitude=missed)
+    marked.save(folder / "marked.npz", "key")
+    assert MaterialFit.load(folder / "marked.npz", "key").unsampled_attitude == missed
+    assert MaterialFit.load(folder / "marked.npz", "key").restarts == 1
+    write_light_curve_report(replace(inversion, fits=[marked if f is best else f for f in inversion.fits]), folder / "marked")
+    text = (folder / "marked" / "report.html").read_text()
+    assert "solar_glass (1 restart)" in text and "For solar_glass, a second attitude (yaw -40.0" in text, text[:2000]
 
 
 @pytest.mark.parametrize("change, words", [

@@ -7,7 +7,9 @@ Each render draws the material's parameters from its own priors and the attitude
 of the paper's site every 30 s, and inverts it against the true material alone. Where the posterior is calibrated,
 the rank of each true offset among its posterior draws is uniform: printed are the coverage of the 50 % and 90 %
 central intervals against their binomial ranges, and a chi-square test of the ranks in five bins. Renders whose
-light is too faint to measure at any time are skipped and counted.
+light is too faint to measure at any time are skipped and counted; a fit that stalls past its restarts is counted
+apart; a fit whose draws miss the mirrored attitude (``detect.attitude_modes``) is named, with whether the truth
+lies nearer that attitude than the draws' median.
 """
 
 from __future__ import annotations

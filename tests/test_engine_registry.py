@@ -187,21 +187,27 @@ def test_sampling_after_the_exploration_stops_at_its_likelihood_budget():
     from nautilus import Sampler
 
     from spacepol.infer.engines.nested import explore_then_sample
+    from spacepol.infer.engines.stall_guard import CallClock
 
     class Counted(Sampler):
         def run(self, **options):
             self.calls_before.append(self.n_like)
             return super().run(**options)
 
+    clock = CallClock()
+
+    def log_likelihood(x):
+        clock.tick()
+        return -0.5 * np.sum(((x - 0.5) / 0.03) ** 2, axis=-1)
+
     def sampler():
-        s = Counted(lambda u: u, lambda x: -0.5 * np.sum(((x - 0.5) / 0.03) ** 2, axis=-1), n_dim=2, n_live=50,
-                    n_networks=1, vectorized=True, seed=3)
+        s = Counted(lambda u: u, log_likelihood, n_dim=2, n_live=50, n_networks=1, vectorized=True, seed=3)
         s.calls_before = []
         return s
 
     capped = sampler()
-    assert not explore_then_sample(capped, effective_draws=10**6, calls_per_live_point=4)
+    assert not explore_then_sample(capped, effective_draws=10**6, clock=clock, what="test", calls_per_live_point=4)
     spent = capped.n_like - capped.calls_before[1]  # after the exploration
     assert 4 * 50 <= spent <= 4 * 50 + 50, (capped.calls_before, spent)  # nautilus stops at the first batch past it
     reached = sampler()
-    assert explore_then_sample(reached, effective_draws=150, calls_per_live_point=4), reached.n_eff
+    assert explore_then_sample(reached, effective_draws=150, clock=clock, what="test", calls_per_live_point=4), reached.n_eff

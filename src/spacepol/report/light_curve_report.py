@@ -59,20 +59,10 @@ FEW_EFFECTIVE_DRAWS = 200  # below this a candidate's posterior summary is rough
 LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider than this is reported as not determined
 
 
-def write_light_curve_report(inversion, out: Path) -> dict:
-    """lightcurve.json, light_curve.png, attitude_corner.png (where the attitude was inferred) and report.html in
-    ``out``; returns lightcurve.json's content."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    content = inversion.to_json()
-    write_json(out / "lightcurve.json", content)
-    save_figure(light_curve_figure(inversion), out / "light_curve.png")
-    corner_fig = attitude_figure(inversion.best)
-    if corner_fig is not None:
-        save_figure(corner_fig, out / "attitude_corner.png")
-    rows = [[r["material"], f"{r['elpd']:.1f} +- {r['elpd_se']:.1f}", f"{r['delta_elpd']:.1f} +- {r['delta_elpd_se']:.1f}",
-             f"{r['delta_log_evidence']:.1f}", f"{content['candidates'][r['material']]['effective_draws']:.0f}"]
-            for r in content["ranking"]]
+def verdict_text(content: dict) -> str:
+    """The report's verdict in words from lightcurve.json's ``content``: the material the curve reads as and by how
+    much, and every caution the fits carry (few effective draws, restarted explorations, an attitude the draws miss,
+    offsets the curve does not determine)."""
     second = content["ranking"][1] if len(content["ranking"]) > 1 else None
     verdict = f"The light curve reads as {content['best']}"
     if second is not None:
@@ -101,6 +91,24 @@ def write_light_curve_report(inversion, out: Path) -> dict:
     if loose:
         verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "
                     f"modes or a direction the pass does not see): {', '.join(loose)}.")
+    return verdict
+
+
+def write_light_curve_report(inversion, out: Path) -> dict:
+    """lightcurve.json, light_curve.png, attitude_corner.png (where the attitude was inferred) and report.html in
+    ``out``; returns lightcurve.json's content."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    content = inversion.to_json()
+    write_json(out / "lightcurve.json", content)
+    save_figure(light_curve_figure(inversion), out / "light_curve.png")
+    corner_fig = attitude_figure(inversion.best)
+    if corner_fig is not None:
+        save_figure(corner_fig, out / "attitude_corner.png")
+    rows = [[r["material"], f"{r['elpd']:.1f} +- {r['elpd_se']:.1f}", f"{r['delta_elpd']:.1f} +- {r['delta_elpd_se']:.1f}",
+             f"{r['delta_log_evidence']:.1f}", f"{content['candidates'][r['material']]['effective_draws']:.0f}"]
+            for r in content["ranking"]]
+    verdict = verdict_text(content)
     estimates = [[k, f"{v['median']:.4g}", f"[{v['q05']:.4g}, {v['q95']:.4g}]"]
                  for k, v in (content["attitude"] | content["parameters"]).items()]
     sections = [("Verdict", H.paragraph(verdict)),

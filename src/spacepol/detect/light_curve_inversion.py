@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import arviz as az
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SamplerStalled
 from ..infer.diagnostics import loo
 from ..io.light_curve import OBSERVABLES
 from ..orbit.attitude import ANGLES
@@ -128,7 +128,6 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode."""
     from nautilus import Sampler
 
-    from ..errors import SamplerStalled
     from ..infer.engines.nested import explore_then_sample, kish_draws, replicate_draws
     from ..infer.engines.stall_guard import CallClock
 

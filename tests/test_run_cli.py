@@ -121,9 +121,11 @@ def test_ptfe_run_by_laplace_explains_the_index(tmp_path):
     # the walkers' spread over the importance draws sits near its limit here (1.075 x against 1.08 on an Intel Xeon):
     # either engine is a right outcome, as long as the run says which one ran and why
     if s["engine"] == "laplace-is":
-        from spacepol.infer.spread_check import MAX_SD_GROWTH
+        from spacepol.infer.spread_check import BOUNDED_K, MAX_SD_GROWTH
 
-        assert d["pareto_k"] < 0.7 and d["ess_min"] >= 100 and d["sd_growth_max"] <= MAX_SD_GROWTH, d
+        assert d["pareto_k"] < 0.7 and d["ess_min"] >= 100, d
+        # the walkers ran and kept the width, or the weights were bounded and they were not needed
+        assert (d["sd_growth_max"] <= MAX_SD_GROWTH if d["sd_growth_max"] is not None else d["pareto_k"] <= BOUNDED_K), d
     else:
         assert s["engine"] == "emcee" and "spread" in s["laplace_refused"] and d["rhat_max"] < 1.05, (s["engine"], d)
     assert s["observables_not_fitted"] == {"dop": "mueller", "stokes": "mueller"}

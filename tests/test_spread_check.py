@@ -12,7 +12,7 @@ from spacepol.infer.inversion import laplace_fit
 from spacepol.infer.laplace import laplace_importance
 from spacepol.infer.optimum import find_optimum
 from spacepol.infer.posterior import Posterior
-from spacepol.infer.spread_check import MAX_SD_GROWTH, spread_check
+from spacepol.infer.spread_check import BOUNDED_K, MAX_SD_GROWTH, spread_check
 from spacepol.io import read_measurements
 from spacepol.paths import bundled
 from spacepol.physics import Model
@@ -37,6 +37,7 @@ def test_draws_trusted_by_pareto_k_on_a_curved_band_are_refused_by_the_walkers_s
     for seed in range(1, 7):
         sample = laplace_importance(post, centre, np.random.default_rng(seed))
         assert sample is not None and sample.reliable, "the control: the weights' own checks trust these draws"
+        assert sample.pareto_k > BOUNDED_K + 0.2, f"k {sample.pareto_k:.2f}: the walkers run on this band"
         check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0])
         j = check.names.index("n")
         growths.append(check.ratios[j])
@@ -51,17 +52,42 @@ def test_draws_trusted_by_pareto_k_on_a_curved_band_are_refused_by_the_walkers_s
     assert result is None and "spread beyond them" in why and "n " in why, why
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_right_draws_keep_their_width_under_the_walkers(seed):
-    """The negative control: on the 84-point paper set (near-Gaussian; Laplace-IS agrees with emcee there,
-    ``test_laplace``) no parameter's SD grows beyond the limit; the margin is printed."""
+@pytest.fixture(scope="module")
+def paper_set():
+    """The 84-point paper set's posterior (near-Gaussian) and its optimum."""
     post = Posterior.build(read_measurements(bundled("synthetic", "hidden_effect.csv")), Model.from_string("paper"))
     _, centre = find_optimum(post, np.random.default_rng(0))
+    return post, centre
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_right_draws_keep_their_width_under_the_walkers(paper_set, seed):
+    """The negative control: on the 84-point paper set (near-Gaussian; Laplace-IS agrees with emcee there,
+    ``test_laplace``) no parameter's SD grows beyond the limit; the margin is printed. (The engine runs no walkers
+    here, their weights being bounded: ``test_bounded_weights_need_no_walkers``.)"""
+    post, centre = paper_set
     sample = laplace_importance(post, centre, np.random.default_rng(seed))
-    check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0])
+    check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0], skip_bounded=False)
     name, widest = check.widest
     assert widest < MAX_SD_GROWTH - 0.03, f"{name}'s SD grew {widest:.3f}x (limit {MAX_SD_GROWTH}): {check.to_json()}"
     assert check.refusal == ""
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bounded_weights_need_no_walkers(paper_set, seed):
+    """Where the weights' Pareto k is at most ``BOUNDED_K`` (their tail bounded) the walkers are not run, and the
+    fit says so; on the same draws the walkers, run anyway, keep the width (the control above): skipping them
+    changes the cost, not the answer. The margin of k below the bound is printed."""
+    post, centre = paper_set
+    sample = laplace_importance(post, centre, np.random.default_rng(seed))
+    margin = BOUNDED_K - sample.pareto_k
+    assert margin > 0.05, f"Pareto k {sample.pareto_k:.3f}: {margin:.3f} below {BOUNDED_K}"
+    check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0])
+    assert check.steps == 0 and check.refusal == "" and check.widest == (None, None)
+    assert check.to_json()["walkers_run"] is False and "bounded" in check.to_json()["why"]
+    result, why = laplace_fit(post, centre, seed=seed)
+    assert result is not None, why
+    assert result.summary.diagnostics["sd_growth_max"] is None
 
 
 def test_the_dop_ridges_trusted_draws_are_refused_by_the_walkers_spread_too():
@@ -70,7 +96,7 @@ def test_the_dop_ridges_trusted_draws_are_refused_by_the_walkers_spread_too():
     post = band_posterior(METAL)
     _, centre = find_optimum(post, np.random.default_rng(0))
     sample = laplace_importance(post, centre, np.random.default_rng(6))
-    assert sample.reliable
+    assert sample.reliable and sample.pareto_k > BOUNDED_K + 0.2, sample.pareto_k
     check = spread_check(post, sample, np.random.default_rng(6).spawn(1)[0])
     growth = dict(zip(check.names, check.ratios))
     assert growth["n"] > MAX_SD_GROWTH + 0.2, growth

@@ -23,6 +23,14 @@ BATCHES = 5
 # a chain SD this many times the draws' refuses them: draws more than 7 % narrower than what the walkers find, placed
 # between the growth correct draws show (<= 1.04) and the 10 % shortfall no accepted posterior may have
 MAX_SD_GROWTH = 1.08
+# a growth between this and MAX_SD_GROWTH after STEPS is not yet a decision: above the 1.04 right draws reach, within
+# the ratio's Monte-Carlo SE (0.02-0.04) of the limit, where a band's walkers may still be on their way out (the metal
+# band, draws at 0.86 of emcee's SD of n: 1.07 after 2,000 steps, 1.15 after 4,000). The walkers go on for STEPS
+# more and the later half decides
+EXTEND_ABOVE = 1.05
+# Pareto k at or below this: the weights' tail is bounded, and the walkers are not run (``SpreadCheck.bounded``).
+# Measured (``benchmarks/laplace_ridges.py``): on the curved bands k 0.35-0.67; on the 84-point paper set -0.22 to -0.10
+BOUNDED_K = 0.0
 
 
 @dataclass(frozen=True)
@@ -35,10 +43,22 @@ class SpreadCheck:
     standard_error: np.ndarray
     steps: int
     walkers: int
+    bounded_by: float | None = None  # the draws' Pareto k where the walkers were not run (``bounded``)
+
+    @classmethod
+    def bounded(cls, names, pareto_k: float) -> SpreadCheck:
+        """The check where the weights' tail is bounded (Pareto k <= ``BOUNDED_K``): no walkers are run. Bounded
+        weights p/q make importance sampling's moments consistent; draws too narrow for the posterior leave mass
+        where the proposal is thin, and the draws that reach its edge then carry the largest weights (k > 0)."""
+        nothing = np.full(len(names), np.nan)
+        return cls(names=tuple(names), ratios=nothing, standard_error=nothing, steps=0, walkers=0,
+                   bounded_by=float(pareto_k))
 
     @property
-    def widest(self) -> tuple[str, float]:
-        """(the parameter whose SD grew most, its ratio)."""
+    def widest(self) -> tuple[str | None, float | None]:
+        """(the parameter whose SD grew most, its ratio); (None, None) where the walkers were not run."""
+        if self.bounded_by is not None:
+            return None, None
         j = int(np.argmax(self.ratios))
         return self.names[j], float(self.ratios[j])
 
@@ -46,15 +66,19 @@ class SpreadCheck:
     def refusal(self) -> str:
         """Why the draws are too narrow, in words ("" where no parameter's SD grew beyond ``MAX_SD_GROWTH``)."""
         grown = [f"{n} {r:.2f}x" for n, r in zip(self.names, self.ratios) if not r <= MAX_SD_GROWTH]
-        if not grown:
+        if not grown or self.bounded_by is not None:
             return ""
         return (f"emcee walkers started inside the importance draws spread beyond them in {self.steps} steps "
                 f"(chain SD over the draws' SD: {', '.join(grown)} > {MAX_SD_GROWTH:g}): the draws are narrower than "
                 "the posterior")
 
     def to_json(self) -> dict:
-        """Per parameter the ratio and its standard error, and the run's size."""
-        return {"sd_ratio": dict(zip(self.names, map(float, self.ratios))),
+        """Per parameter the ratio and its standard error, and the run's size (where the walkers were not run, the
+        Pareto k that made them unnecessary)."""
+        if self.bounded_by is not None:
+            return {"walkers_run": False, "pareto_k": self.bounded_by, "bounded_k": BOUNDED_K,
+                    "why": f"Pareto k {self.bounded_by:.2f} <= {BOUNDED_K:g}: the importance weights are bounded"}
+        return {"walkers_run": True, "sd_ratio": dict(zip(self.names, map(float, self.ratios))),
                 "sd_ratio_se": dict(zip(self.names, map(float, self.standard_error))),
                 "steps": self.steps, "walkers": self.walkers, "limit": MAX_SD_GROWTH}
 
@@ -80,8 +104,11 @@ def _starts(space: SamplingSpace, sample, rng: np.random.Generator, walkers: int
 
 
 def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS,
-                 walkers: int | None = None) -> SpreadCheck:
-    """Run emcee's ensemble from ``sample`` (an ``laplace.ImportanceSample`` of ``posterior``) and compare SDs."""
+                 walkers: int | None = None, skip_bounded: bool = True) -> SpreadCheck:
+    """Run emcee's ensemble from ``sample`` (an ``laplace.ImportanceSample`` of ``posterior``) and compare SDs; with
+    ``skip_bounded``, not where the weights' Pareto k is at most ``BOUNDED_K`` (``SpreadCheck.bounded``)."""
+    if skip_bounded and sample.pareto_k <= BOUNDED_K:
+        return SpreadCheck.bounded(posterior.names, sample.pareto_k)
     space = SamplingSpace(posterior.priors)
     ndim = posterior.ndim
     walkers = walkers or max(MIN_WALKERS, default_walkers(ndim))
@@ -92,10 +119,20 @@ def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS
     sampler.log_prob_fn = log_prob  # called directly: emcee's wrapper prints every walker on an exception
     sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
     sampler.run_mcmc(_starts(space, sample, rng, walkers), steps, progress=False)
-    chain = space.to_theta(sampler.get_chain(discard=steps // 2))  # (steps/2, walkers, D)
     draws_sd = weighted_sd(sample.theta, sample.log_weights)
-    ratios = chain.reshape(-1, ndim).std(axis=0) / draws_sd
+    check = _compared(sampler, space, posterior.names, draws_sd, walkers)
+    if EXTEND_ABOVE <= check.widest[1] <= MAX_SD_GROWTH:  # undecided: the walkers go on
+        sampler.run_mcmc(None, steps, progress=False)
+        check = _compared(sampler, space, posterior.names, draws_sd, walkers)
+    return check
+
+
+def _compared(sampler, space: SamplingSpace, names, draws_sd: np.ndarray, walkers: int) -> SpreadCheck:
+    """The SDs of the second half of the walkers' run so far over the draws' SDs, with batch-means SEs."""
+    steps = sampler.iteration
+    chain = space.to_theta(sampler.get_chain(discard=steps // 2))  # (steps/2, walkers, D)
+    ratios = chain.reshape(-1, chain.shape[-1]).std(axis=0) / draws_sd
     # batch means: the SD of each of BATCHES consecutive stretches of the kept steps, their scatter over sqrt(BATCHES)
-    batches = np.array([b.reshape(-1, ndim).std(axis=0) for b in np.array_split(chain, BATCHES)]) / draws_sd
+    batches = np.array([b.reshape(-1, chain.shape[-1]).std(axis=0) for b in np.array_split(chain, BATCHES)]) / draws_sd
     se = batches.std(axis=0, ddof=1) / np.sqrt(BATCHES)
-    return SpreadCheck(names=tuple(posterior.names), ratios=ratios, standard_error=se, steps=steps, walkers=walkers)
+    return SpreadCheck(names=tuple(names), ratios=ratios, standard_error=se, steps=steps, walkers=walkers)

@@ -24,7 +24,7 @@ def invert_laplace(posterior: Posterior, centre, seed: int = 0, draws: int = 200
     importance sampling (``laplace``): ``draws`` equally weighted draws resampled from as many weighted ones, and
     PSIS-LOO that accounts for the approximation. None where the approximation cannot be trusted (Pareto k > 0.7,
     fewer than 400 effective draws, weights collapsed onto the mode, emcee walkers started inside the draws spreading
-    beyond them (``spread_check``), no negative definite Hessian): the caller samples
+    beyond them (``spread_check``; not run where the weights are bounded), no negative definite Hessian): the caller samples
     with emcee (``invert``); ``laplace_fit`` says why. ``summary.diagnostics`` holds the weights' Pareto k and
     effective draws; R-hat and tau do not apply."""
     return laplace_fit(posterior, centre, seed, draws)[0]

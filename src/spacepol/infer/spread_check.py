@@ -48,8 +48,8 @@ class SpreadCheck:
     @classmethod
     def bounded(cls, names, pareto_k: float) -> SpreadCheck:
         """The check where the weights' tail is bounded (Pareto k <= ``BOUNDED_K``): no walkers are run. Bounded
-        weights p/q make importance sampling's moments consistent; draws too narrow for the posterior leave mass
-        where the proposal is thin, and the draws that reach its edge then carry the largest weights (k > 0)."""
+        weights p/q give importance sampling's moments a finite variance; draws too narrow for the posterior leave
+        mass where the proposal is thin, and the draws that reach its edge then carry the largest weights (k > 0)."""
         nothing = np.full(len(names), np.nan)
         return cls(names=tuple(names), ratios=nothing, standard_error=nothing, steps=0, walkers=0,
                    bounded_by=float(pareto_k))

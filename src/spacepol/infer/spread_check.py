@@ -65,8 +65,10 @@ class SpreadCheck:
     @property
     def refusal(self) -> str:
         """Why the draws are too narrow, in words ("" where no parameter's SD grew beyond ``MAX_SD_GROWTH``)."""
+        if self.bounded_by is not None:
+            return ""
         grown = [f"{n} {r:.2f}x" for n, r in zip(self.names, self.ratios) if not r <= MAX_SD_GROWTH]
-        if not grown or self.bounded_by is not None:
+        if not grown:
             return ""
         return (f"emcee walkers started inside the importance draws spread beyond them in {self.steps} steps "
                 f"(chain SD over the draws' SD: {', '.join(grown)} > {MAX_SD_GROWTH:g}): the draws are narrower than "
@@ -120,19 +122,19 @@ def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS
     sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
     sampler.run_mcmc(_starts(space, sample, rng, walkers), steps, progress=False)
     draws_sd = weighted_sd(sample.theta, sample.log_weights)
-    check = _compared(sampler, space, posterior.names, draws_sd, walkers)
+    check = _compared(sampler, space, posterior.names, draws_sd)
     if EXTEND_ABOVE <= check.widest[1] <= MAX_SD_GROWTH:  # undecided: the walkers go on
         sampler.run_mcmc(None, steps, progress=False)
-        check = _compared(sampler, space, posterior.names, draws_sd, walkers)
+        check = _compared(sampler, space, posterior.names, draws_sd)
     return check
 
 
-def _compared(sampler, space: SamplingSpace, names, draws_sd: np.ndarray, walkers: int) -> SpreadCheck:
+def _compared(sampler, space: SamplingSpace, names, draws_sd: np.ndarray) -> SpreadCheck:
     """The SDs of the second half of the walkers' run so far over the draws' SDs, with batch-means SEs."""
-    steps = sampler.iteration
+    steps, ndim = sampler.iteration, len(names)
     chain = space.to_theta(sampler.get_chain(discard=steps // 2))  # (steps/2, walkers, D)
-    ratios = chain.reshape(-1, chain.shape[-1]).std(axis=0) / draws_sd
+    ratios = chain.reshape(-1, ndim).std(axis=0) / draws_sd
     # batch means: the SD of each of BATCHES consecutive stretches of the kept steps, their scatter over sqrt(BATCHES)
-    batches = np.array([b.reshape(-1, chain.shape[-1]).std(axis=0) for b in np.array_split(chain, BATCHES)]) / draws_sd
+    batches = np.array([b.reshape(-1, ndim).std(axis=0) for b in np.array_split(chain, BATCHES)]) / draws_sd
     se = batches.std(axis=0, ddof=1) / np.sqrt(BATCHES)
-    return SpreadCheck(names=tuple(names), ratios=ratios, standard_error=se, steps=steps, walkers=walkers)
+    return SpreadCheck(names=tuple(names), ratios=ratios, standard_error=se, steps=steps, walkers=sampler.nwalkers)

@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 import spacepol
-from spacepol.infer import likelihood
+from spacepol.infer import likelihood_blocks
 from spacepol.infer.posterior import Posterior
 from spacepol.paths import bundled
 from spacepol.physics import Model
@@ -47,7 +47,7 @@ def main() -> None:
         post = Posterior.build(data, Model.from_string("paper"))
         theta_all = post.priors.rescale(np.random.default_rng(0).random((4096, post.ndim)))
         # the count of sets in large calls that switches the block of 256 on, set so that each table shows one rule
-        post.likelihood._sets_in_large_calls = likelihood._SETS_PAYING_A_COMPILATION if large else -10**12
+        post.likelihood._sets_in_large_calls = likelihood_blocks.SETS_PAYING_A_COMPILATION if large else -10**12
         print(f"\n{label}: compiled sizes {post.likelihood._compiled_sizes()}")
         print("| sets per call | first call (s) | us per set |\n|---|---|---|")
         for n in (16, 64, 256, 1024, 4096):

@@ -131,12 +131,12 @@ def test_large_batches_are_blocked_and_padded_without_changing_a_value():
     set), and through a block of 256 once the likelihood has evaluated enough sets in large calls to pay for its
     compilation: every value equals the same set's value evaluated on its own, the two block sizes agree, a
     length-1 column is shared by all blocks, and the block sizes follow the documented rule."""
-    from spacepol.infer.likelihood import _SETS_PAYING_A_COMPILATION, _block_rows
+    from spacepol.infer.likelihood_blocks import SETS_PAYING_A_COMPILATION, block_rows
     from spacepol.physics.geometry import default_grid
 
-    assert [_block_rows(n, [16]) for n in (5, 17, 300)] == [16, 16, 16]
-    assert [_block_rows(n, [16, 256]) for n in (40, 200, 300, 512)] == [16, 256, 256, 256]
-    assert [_block_rows(n, [16, 32]) for n in (20, 30, 100)] == [16, 32, 32]
+    assert [block_rows(n, [16]) for n in (5, 17, 300)] == [16, 16, 16]
+    assert [block_rows(n, [16, 256]) for n in (40, 200, 300, 512)] == [16, 256, 256, 256]
+    assert [block_rows(n, [16, 32]) for n in (20, 30, 100)] == [16, 32, 32]
     model, g = Model.from_string("paper"), default_grid()
     data = Dataset(g.theta_i, g.theta_r, g.dphi)
     data.dop, data.dop_err = model.evaluate({}, g).dop, np.full(g.size, 0.01)
@@ -152,7 +152,7 @@ def test_large_batches_are_blocked_and_padded_without_changing_a_value():
     np.testing.assert_allclose(total[picks], alone, rtol=1e-12)
     assert np.all(np.isfinite(total)) and len(np.unique(total)) > n_sets // 2  # negative control: sets differ
     assert lik._compiled_sizes() == [16]
-    for _ in range(_SETS_PAYING_A_COMPILATION // n_sets):
+    for _ in range(SETS_PAYING_A_COMPILATION // n_sets):
         lik.total(sets)
     assert lik._compiled_sizes() == [16, 256]  # 19 blocks of 256 and a remainder of 136 in blocks of 16
     np.testing.assert_allclose(lik.total(sets), total, rtol=1e-12)

@@ -139,3 +139,25 @@ def test_dop_alone_equals_the_dop_of_the_whole_prediction():
         alone, whole = model.dop(params, g), model.evaluate(params, g).dop
         assert alone.shape == whole.shape and np.allclose(alone, whole, rtol=1e-14, atol=1e-15)
     assert not np.allclose(model.dop(sets, g)[0], model.dop(sets, g)[1])  # the sets differ: not one row repeated
+
+
+def test_the_likelihood_sums_its_wavelengths_one_by_one_and_keeps_the_rows_order():
+    """The compiled likelihood of a several-wavelength model takes one wavelength at a time (``Program.part``): its
+    pointwise values, rows interleaved over the wavelengths, are each wavelength's own likelihood's at that
+    wavelength's rows, and its fused total is their sum, for five parameter sets."""
+    from spacepol.infer.likelihood import Likelihood
+
+    model = SpectralModel(Model.from_string(BASE), LAMBDAS, {"n": "cauchy"})
+    data = _cauchy_set().select(np.random.default_rng(4).permutation(len(_cauchy_set())))
+    sets = {**{k: np.full(5, v) for k, v in TRUTH.items()}, "sigma": np.linspace(0.1, 0.5, 5)}
+    whole = Likelihood(data, model)
+    pointwise = whole.pointwise(sets).reshape(5, len(whole.observables), len(data))
+    expected_total = np.zeros(5)
+    for j, lam in enumerate(LAMBDAS):
+        rows = np.flatnonzero(np.isclose(data.wavelength_um, lam))
+        alone = Likelihood(data.select(rows), model.model)
+        own = alone.pointwise(model.values_at(sets, j)).reshape(5, len(alone.observables), rows.size)
+        assert np.allclose(pointwise[:, :, rows], own, rtol=1e-12, atol=1e-12)
+        expected_total += alone.total(model.values_at(sets, j))
+    assert np.allclose(whole.total(sets), expected_total, rtol=1e-12)
+    assert np.ptp(whole.total(sets)) > 1.0  # the sets differ: not one value repeated

@@ -25,34 +25,8 @@ from ..physics.arrays import array_module
 from ..physics.compiled import Program, set_matrix
 from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
-
-_CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
-# every likelihood compiles one block of 16 sets (and the callers' exact sizes, e.g. emcee's half-ensemble); a call of
-# more sets goes through it in blocks. Each further size is a compilation of its own (the largest part of a
-# diagnosis on a small data set: ``benchmarks/diagnose_cost_ratio.py --profile``), so the larger block is compiled
-# only once the sets this likelihood has evaluated in calls of at least its size would have paid for it about twice
-# over: on the 84-point DOP set a set costs ~4x less in blocks of 256 than in blocks of 16, and the block's compilation
-# as much as ~25,000 sets in blocks of 16 (``benchmarks/likelihood_blocks.py``)
-_BLOCK_SETS = 16
-_LARGE_BLOCK_SETS = 256
-_SETS_PAYING_A_COMPILATION = 50_000
-_ONE_BLOCK_NUMBERS = 1 << 15
-# ``total`` reads a large likelihood's pointwise program where a call's block holds at most this many numbers: beyond
-# it the unfused values no longer stay in the cache (all of PTFE, 7,296 geometries x 16 elements, ``paper`` at four
-# wavelengths: 30 sets 0.78x the fused total's time, 64 sets 1.35x)
-_POINTWISE_NUMBERS = 4_000_000
-
-
-def _block_rows(n_sets: int, sizes: list) -> int:
-    """Sets per compiled call: the smallest compiled size that holds them all where padding wastes at most a quarter
-    of it (or no size is smaller), else blocks of the largest size that fits (40 sets: three calls of 16, not one
-    of 256; 512 sets: two calls of 256)."""
-    fit = next((size for size in sizes if size >= n_sets), None)
-    below = [size for size in sizes if size <= n_sets]
-    if fit is not None and (fit - n_sets <= fit // 4 or not below):
-        return fit
-    return below[-1]
-
+from .likelihood_blocks import (BLOCK_SETS, LARGE_BLOCK_SETS, ONE_BLOCK_NUMBERS, POINTWISE_NUMBERS, SETS_PAYING_A_COMPILATION,
+                                SETS_PAYING_THE_SUM, Rows, block_rows, in_cache_sized_chunks)
 
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
     """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
@@ -120,7 +94,8 @@ class Likelihood:
         # batch sizes a caller will use again and again (emcee's half-ensemble): compiled exactly, not padded
         self.exact_sizes: set[int] = set()
         self._sizes_for, self._sizes = None, []  # ``_compiled_sizes``'s last answer and the exact sizes it was for
-        self._sets_in_large_calls = 0  # sets evaluated in calls of at least ``_LARGE_BLOCK_SETS`` (``_compiled_sizes``)
+        self._sets_in_large_calls = 0  # sets evaluated in calls of at least ``LARGE_BLOCK_SETS`` (``_compiled_sizes``)
+        self._sets_in_total_calls = 0  # sets evaluated by ``total`` (``of_matrix``)
 
     @property
     def numbers_per_set(self) -> int:
@@ -132,14 +107,14 @@ class Likelihood:
         """How many parameter sets one vectorised evaluation should take: intermediate arrays of
         sets x geometries x (16 Mueller or 4 Stokes) values stay near 4 million numbers (~32 MB); a multiple of the
         compiled block of 16 sets."""
-        return max(_BLOCK_SETS, 4_000_000 // self.numbers_per_set // _BLOCK_SETS * _BLOCK_SETS)
+        return max(BLOCK_SETS, 4_000_000 // self.numbers_per_set // BLOCK_SETS * BLOCK_SETS)
 
     @property
     def compiles_one_block(self) -> bool:
         """Whether calls go through the block of 16 sets (and the caller's ``exact_sizes``) only, however many sets they
         evaluate: where one block's evaluation outweighs a call's fixed cost, a larger block would only add a
         compilation."""
-        return _BLOCK_SETS * self.numbers_per_set >= _ONE_BLOCK_NUMBERS
+        return BLOCK_SETS * self.numbers_per_set >= ONE_BLOCK_NUMBERS
 
     @property
     def n_obs(self) -> int:
@@ -201,9 +176,10 @@ class Likelihood:
 
     def total(self, params: dict) -> np.ndarray:
         """Log-likelihood per parameter set, (P,): the pointwise sum, fused (nothing of size n_obs is kept); on a
-        large data set (``compiles_one_block``), where a call's block holds at most ``_POINTWISE_NUMBERS`` numbers,
+        large data set (``compiles_one_block``), where a call's block holds at most ``POINTWISE_NUMBERS`` numbers,
         the sum of ``pointwise``, so that a model compiles one likelihood program, not two (a call of either costs
-        far less than a compilation, and every model diagnose refits needs the pointwise one too)."""
+        far less than a compilation, and every model diagnose refits needs the pointwise one too), until the sets
+        evaluated here would have paid for the fused program's compilation (``SETS_PAYING_THE_SUM``)."""
         return self._call(1, params)
 
     @property
@@ -239,12 +215,15 @@ class Likelihood:
         """``_call`` with the parameter sets already one (P, len(names)) matrix (None: no column) and the held values
         ``scalars`` ((name, value), ... sorted by name): what a sampler's every step calls, without the dict."""
         n_sets = 0 if matrix is None else len(matrix)
-        if n_sets >= _LARGE_BLOCK_SETS:
+        if n_sets >= LARGE_BLOCK_SETS:
             self._sets_in_large_calls += n_sets
         sizes = self._compiled_sizes()
-        rows = _block_rows(n_sets, sizes)
+        rows = block_rows(n_sets, sizes)
         # ``total`` of a large likelihood: the pointwise program, summed (see ``total``)
-        summed = which == 1 and self.compiles_one_block and rows * self.numbers_per_set <= _POINTWISE_NUMBERS
+        if which == 1:
+            self._sets_in_total_calls += n_sets
+        summed = (which == 1 and self.compiles_one_block and rows * self.numbers_per_set <= POINTWISE_NUMBERS
+                  and self._sets_in_total_calls <= SETS_PAYING_THE_SUM)
         key = (0 if summed else which, names, scalars, levels)
         if key not in self._jitted:
             self._jitted[key] = self._compile(*key)
@@ -267,10 +246,10 @@ class Likelihood:
         """The block sizes calls are padded to: 16 sets, the callers' exact sizes, and 256 sets once the sets this
         likelihood evaluated in calls of that size would have paid for its compilation (never on a large data set:
         ``compiles_one_block``). Kept until these change: a sampler calls this at every step."""
-        large = not self.compiles_one_block and self._sets_in_large_calls >= _SETS_PAYING_A_COMPILATION
+        large = not self.compiles_one_block and self._sets_in_large_calls >= SETS_PAYING_A_COMPILATION
         state = (frozenset(self.exact_sizes), large)
         if self._sizes_for != state:
-            self._sizes_for, self._sizes = state, sorted({_BLOCK_SETS, *([_LARGE_BLOCK_SETS] if large else []), *state[0]})
+            self._sizes_for, self._sizes = state, sorted({BLOCK_SETS, *([LARGE_BLOCK_SETS] if large else []), *state[0]})
         return self._sizes
 
     def _compile(self, which: int, names: tuple, scalars: tuple, levels: tuple = ()):
@@ -287,67 +266,81 @@ class Likelihood:
         program, fixed = self._program, dict(scalars)
         model_names = {p.name for p in self.model.parameters}
         mueller = self.needs_mueller
-        # the data are constants of the compiled function (as arguments they would be handled on every call)
-        y = {ch: jnp.asarray(v) for ch, v in self._y.items()}
-        errors = {ch: jnp.asarray(e) for ch, e in self._errors.items()}
-        profiles = {ch: jnp.asarray(f) for ch, f in self._profile.items()}
-
         if levels and self.robust:
             raise ValueError("noise levels are profiled under the Gaussian likelihood only (robust=False)")
         profiled_names = [name for name, _, _ in levels]
-
         groups = self._channel_groups()
+        whole = self._rows_of(lambda values: program(values, program.inputs), slice(None))
+        # one wavelength at a time where a reduction over the rows allows it (``Program.part``)
+        parts = [self._rows_of(lambda values, j=j: program.part(j, values, program.inputs), program.part_rows(j))
+                 for j in range(len(program.parts))] if len(program.parts) > 1 else [whole]
 
-        def residuals(values):
+        def residuals(values, rows: Rows):
             """Each channel group's residuals, (channels, P or 1, N or 1), in ``self.observables``' order."""
-            total, dop = program({k: v for k, v in values.items() if k in model_names}, program.inputs)
+            total, dop = rows.evaluate({k: v for k, v in values.items() if k in model_names})
             prediction = Prediction.from_total(total, dop, mueller)
             out, predicted = [], {}
             for o, channels in groups:
                 if len(channels) > 1:  # one array for the group (``Observable.predict_stacked``)
-                    observed = jnp.stack([y[ch] for ch in channels])[:, None, :]
+                    observed = jnp.stack([rows.y[ch] for ch in channels])[:, None, :]
                     out.append(o.residual(channels[0], observed, o.predict_stacked(prediction), self.inferred(channels[0])))
                     continue
                 ch = channels[0]
                 if ch not in predicted:
                     predicted.update(o.predict(prediction))
-                out.append(o.residual(ch, y[ch], predicted[ch], self.inferred(ch))[None])
+                out.append(o.residual(ch, rows.y[ch], predicted[ch], self.inferred(ch))[None])
             return out
 
-        def channel_blocks(matrix):
+        def channel_blocks(matrix, rows: Rows):
             """(the log-likelihood of each channel group, (channels, P, N) each, in ``self.observables``' order;
             the profiled levels' values, (P,) each, in ``levels``' order)."""
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
-            resids = residuals(values)
-            profiled = self._profiled(levels, groups, resids, matrix.shape[0], errors, profiles) if levels else []
+            resids = residuals(values, rows)
+            profiled = self._profiled(levels, groups, resids, matrix.shape[0], rows.errors, rows.profiles) if levels else []
             values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
             blocks = []
             for (_, channels), resid in zip(groups, resids):
                 # each channel's noise as (P or 1, N or 1), stacked over the group's channels
-                scales = [jnp.asarray(errors[ch] if ch in errors else values[self.noise_parameter(ch)] * profiles.get(ch, 1.0))
+                scales = [jnp.asarray(rows.errors[ch] if ch in rows.errors
+                                      else values[self.noise_parameter(ch)] * rows.profiles.get(ch, 1.0))
                           for ch in channels]
                 scales = [jnp.broadcast_to(sc, jnp.broadcast_shapes(sc.shape, (1, 1))) for sc in scales]
                 scale = jnp.stack(jnp.broadcast_arrays(*scales))
                 lp = self._logpdf(channels[0], resid, scale)
-                blocks.append(jnp.broadcast_to(lp, (len(channels), matrix.shape[0], len(self.data))))
+                blocks.append(jnp.broadcast_to(lp, (len(channels), matrix.shape[0], rows.size)))
             return blocks, profiled
 
         def pointwise(matrix):
-            # (channels, P, N) -> (P, channels x N): each channel's N values in a row, in ``observables``' order
-            return jnp.concatenate([jnp.moveaxis(b, 0, 1).reshape(matrix.shape[0], -1) for b in channel_blocks(matrix)[0]],
-                                   axis=-1)
+            # per group (channels, P, N), the parts side by side in the data's order; then (P, channels x N): each
+            # channel's N values in a row, in ``observables``' order
+            blocks = [jnp.concatenate(group, axis=-1) for group in zip(*(channel_blocks(matrix, r)[0] for r in parts))]
+            if len(parts) > 1 and program.inverse is not None:
+                blocks = [b[..., program.inverse] for b in blocks]
+            return jnp.concatenate([jnp.moveaxis(b, 0, 1).reshape(matrix.shape[0], -1) for b in blocks], axis=-1)
 
-        def summed(matrix):
+        def summed_over(matrix, rows: Rows):
             # the single channels added element by element, then one sum over the rows: one reduction (summed from a
             # concatenation, XLA stored every Mueller element and reduced each channel in a partitioned loop of
             # its own: 32 loops and their hand-overs between threads per call, 16 of them reductions)
-            blocks, profiled = channel_blocks(matrix)
+            blocks, profiled = channel_blocks(matrix, rows)
             single = [b[0] for b in blocks if len(b) == 1]
             value = sum(single).sum(axis=-1) if single else 0.0
             value = value + sum(b.sum(axis=(0, 2)) for b in blocks if len(b) > 1)
             return jnp.stack([value, *profiled], axis=-1) if levels else value
 
-        return pointwise if which == 0 else _in_cache_sized_chunks(summed, self.numbers_per_set)
+        def summed(matrix):
+            # profiled levels need every row's residuals at once
+            return summed_over(matrix, whole) if levels else sum(summed_over(matrix, r) for r in parts)
+
+        return pointwise if which == 0 else in_cache_sized_chunks(summed, self.numbers_per_set)
+
+    def _rows_of(self, evaluate, rows) -> "Rows":
+        """The data of ``rows`` (a slice or indices) as constants of the compiled function (as arguments they would be
+        handled on every call), with the model's evaluation there."""
+        return Rows(evaluate=evaluate, size=len(np.arange(len(self.data))[rows]),
+                     y={ch: jnp.asarray(v[rows]) for ch, v in self._y.items()},
+                     errors={ch: jnp.asarray(e[rows]) for ch, e in self._errors.items()},
+                     profiles={ch: jnp.asarray(f[rows]) for ch, f in self._profile.items()})
 
     def _profiled(self, levels, groups, resids, n_sets, errors, profiles) -> list:
         """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
@@ -381,20 +374,3 @@ class Likelihood:
         nu = self.nu
         const = gammaln((nu + 1) / 2) - gammaln(nu / 2) - 0.5 * math.log(nu * math.pi)
         return const - xp.log(scale) - 0.5 * (nu + 1) * xp.log1p((resid / scale) ** 2 / nu)
-
-
-def _in_cache_sized_chunks(summed, numbers_per_set: int):
-    """``summed`` over a (P, D) matrix in chunks of sets small enough that the sets x geometries intermediates stay
-    in the CPU's cache: above it the evaluation is memory-bound."""
-
-    def total(matrix):
-        n_sets = matrix.shape[0]
-        chunk = min(n_sets, max(1, _CACHE_NUMBERS // numbers_per_set))
-        chunk = next(c for c in range(chunk, 0, -1) if n_sets % c == 0)  # the largest that divides the batch
-        if chunk >= n_sets:
-            return summed(matrix)
-        blocks = matrix.reshape(n_sets // chunk, chunk, matrix.shape[1])
-        out = jax.lax.map(summed, blocks)
-        return out.reshape((n_sets,) + out.shape[2:])
-
-    return total

@@ -194,15 +194,25 @@ class Program:
         inner = model.inner
         self.effects, self.defaults, self.mueller, self.up_to_scale = inner.effects, inner.defaults(), mueller, up_to_scale
         self.parts = model.parts(geometry)  # [(rows, sub-geometry, values -> the inner model's values)]
+        self.size = geometry.size
         order = np.concatenate([np.arange(geometry.size)[rows] for rows, _, _ in self.parts])
         self.inverse = None if np.array_equal(order, np.arange(geometry.size)) else jnp.asarray(np.argsort(order))
         self.inputs = [sub.device_terms() for _, sub, _ in self.parts]
 
+    def part_rows(self, j: int) -> np.ndarray:
+        """The rows of the data (indices) that part ``j`` evaluates, in the order of its output."""
+        return np.arange(self.size)[self.parts[j][0]]
+
+    def part(self, j: int, values: dict, inputs):
+        """Part ``j`` alone (one wavelength of a SpectralModel): (total, dop) at ``part_rows(j)``. A caller that
+        reduces over rows (the likelihood's sum) takes the parts one by one: concatenated, XLA on a CPU fused the
+        X"""
+        (_, sub, inner_values), terms = self.parts[j], inputs[j]
+        return evaluate_values(self.effects, {**self.defaults, **inner_values(values)}, batch_of(values),
+                               Geometry.from_terms(terms, sub.all_visible), self.mueller, self.up_to_scale)
+
     def __call__(self, values: dict, inputs):
-        batch = batch_of(values)
-        outputs = [evaluate_values(self.effects, {**self.defaults, **inner_values(values)}, batch,
-                                   Geometry.from_terms(terms, sub.all_visible), self.mueller, self.up_to_scale)
-                   for (_, sub, inner_values), terms in zip(self.parts, inputs)]
+        outputs = [self.part(j, values, inputs) for j in range(len(self.parts))]
         if len(outputs) == 1:
             return outputs[0]
         total = jnp.concatenate([t for t, _ in outputs], axis=-1)

@@ -26,7 +26,7 @@ from ..physics.compiled import Program, set_matrix
 from ..physics.model import Model, Prediction
 from ..physics.parameter import Parameter
 from .likelihood_blocks import (BLOCK_SETS, LARGE_BLOCK_SETS, ONE_BLOCK_NUMBERS, POINTWISE_NUMBERS, SETS_PAYING_A_COMPILATION,
-                                SETS_PAYING_THE_SUM, Rows, block_rows, in_cache_sized_chunks)
+                                SETS_PAYING_THE_SUM, Rows, block_rows, in_cache_sized_chunks, part_slots)
 
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
     """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
@@ -262,7 +262,7 @@ class Likelihood:
         held fixed. Gradient samplers and optimizers compose it with their own transforms and differentiate it."""
         if self._program is None:
             self._program = Program(self.model, self.geometry, self.needs_mueller,
-                                    up_to_scale=all(o.scale_free for o in self.objects))
+                                    up_to_scale=all(o.scale_free for o in self.objects), fold=True)
         program, fixed = self._program, dict(scalars)
         model_names = {p.name for p in self.model.parameters}
         mueller = self.needs_mueller
@@ -270,89 +270,97 @@ class Likelihood:
             raise ValueError("noise levels are profiled under the Gaussian likelihood only (robust=False)")
         profiled_names = [name for name, _, _ in levels]
         groups = self._channel_groups()
-        whole = self._rows_of(lambda values: program(values, program.inputs), slice(None))
-        # one wavelength at a time where a reduction over the rows allows it (``Program.part``)
-        parts = [self._rows_of(lambda values, j=j: program.part(j, values, program.inputs), program.part_rows(j))
-                 for j in range(len(program.parts))] if len(program.parts) > 1 else [whole]
+        # one wavelength at a time (``Program.part``), each in its mirror fold's slots where the program folds
+        parts = [part_slots(self._y, self._errors, self._profile, program, j, mueller) for j in range(len(program.parts))]
 
-        def residuals(values, rows: Rows):
-            """Each channel group's residuals, (channels, P or 1, N or 1), in ``self.observables``' order."""
-            total, dop = rows.evaluate({k: v for k, v in values.items() if k in model_names})
-            prediction = Prediction.from_total(total, dop, mueller)
-            out, predicted = [], {}
-            for o, channels in groups:
-                if len(channels) > 1:  # one array for the group (``Observable.predict_stacked``)
-                    observed = jnp.stack([rows.y[ch] for ch in channels])[:, None, :]
-                    out.append(o.residual(channels[0], observed, o.predict_stacked(prediction), self.inferred(channels[0])))
-                    continue
-                ch = channels[0]
-                if ch not in predicted:
-                    predicted.update(o.predict(prediction))
-                out.append(o.residual(ch, rows.y[ch], predicted[ch], self.inferred(ch))[None])
-            return out
-
-        def channel_blocks(matrix, rows: Rows):
-            """(the log-likelihood of each channel group, (channels, P, N) each, in ``self.observables``' order;
-            the profiled levels' values, (P,) each, in ``levels``' order)."""
+        def channel_blocks(matrix):
+            """(per slot of every part, the log-likelihood of each channel group, (channels, P, rows) each, in
+            ``self.observables``' order, 0 where a slot holds no row; the profiled levels' values, (P,) each, in
+            ``levels``' order)."""
             values = {**fixed, **{n: matrix[:, j, None] for j, n in enumerate(names)}}
-            resids = residuals(values, rows)
-            profiled = self._profiled(levels, groups, resids, matrix.shape[0], rows.errors, rows.profiles) if levels else []
+            model_values = {k: v for k, v in values.items() if k in model_names}
+            slots, resids = [], []
+            for j, (part_slots, _) in enumerate(parts):
+                total, dop = program.part(j, model_values, program.inputs)
+                slots += part_slots
+                resids += [self._residuals(groups, total, dop, rows) for rows in part_slots]
+            profiled = self._profiled(levels, groups, resids, slots, matrix.shape[0]) if levels else []
             values.update({name: level[:, None] for name, level in zip(profiled_names, profiled)})
-            blocks = []
-            for (_, channels), resid in zip(groups, resids):
-                # each channel's noise as (P or 1, N or 1), stacked over the group's channels
-                scales = [jnp.asarray(rows.errors[ch] if ch in rows.errors
-                                      else values[self.noise_parameter(ch)] * rows.profiles.get(ch, 1.0))
-                          for ch in channels]
-                scales = [jnp.broadcast_to(sc, jnp.broadcast_shapes(sc.shape, (1, 1))) for sc in scales]
-                scale = jnp.stack(jnp.broadcast_arrays(*scales))
-                lp = self._logpdf(channels[0], resid, scale)
-                blocks.append(jnp.broadcast_to(lp, (len(channels), matrix.shape[0], rows.size)))
+            blocks = [self._log_densities(groups, values, slot_resids, rows, matrix.shape[0])
+                      for rows, slot_resids in zip(slots, resids)]
             return blocks, profiled
 
         def pointwise(matrix):
-            # per group (channels, P, N), the parts side by side in the data's order; then (P, channels x N): each
-            # channel's N values in a row, in ``observables``' order
-            blocks = [jnp.concatenate(group, axis=-1) for group in zip(*(channel_blocks(matrix, r)[0] for r in parts))]
-            if len(parts) > 1 and program.inverse is not None:
-                blocks = [b[..., program.inverse] for b in blocks]
-            return jnp.concatenate([jnp.moveaxis(b, 0, 1).reshape(matrix.shape[0], -1) for b in blocks], axis=-1)
+            # per group (channels, P, N): each part's slots side by side, its rows picked from them, the parts side by
+            # side in the data's order; then (P, channels x N): each channel's N values in a row, in ``observables``' order
+            blocks, at = channel_blocks(matrix)[0], 0
+            per_part = []
+            for part_slots, positions in parts:
+                mine, at = blocks[at : at + len(part_slots)], at + len(part_slots)
+                joined = [jnp.concatenate(group, axis=-1) for group in zip(*mine)]
+                per_part.append(joined if positions is None else [b[..., positions] for b in joined])
+            groups_rows = [jnp.concatenate(group, axis=-1) for group in zip(*per_part)]
+            if program.inverse is not None:
+                groups_rows = [b[..., program.inverse] for b in groups_rows]
+            return jnp.concatenate([jnp.moveaxis(b, 0, 1).reshape(matrix.shape[0], -1) for b in groups_rows], axis=-1)
 
-        def summed_over(matrix, rows: Rows):
+        def summed(matrix):
             # the single channels added element by element, then one sum over the rows: one reduction (summed from a
             # concatenation, XLA stored every Mueller element and reduced each channel in a partitioned loop of
             # its own: 32 loops and their hand-overs between threads per call, 16 of them reductions)
-            blocks, profiled = channel_blocks(matrix, rows)
-            single = [b[0] for b in blocks if len(b) == 1]
-            value = sum(single).sum(axis=-1) if single else 0.0
-            value = value + sum(b.sum(axis=(0, 2)) for b in blocks if len(b) > 1)
+            blocks, profiled = channel_blocks(matrix)
+            value = 0.0
+            for slot_blocks in blocks:
+                single = [b[0] for b in slot_blocks if len(b) == 1]
+                value = value + (sum(single).sum(axis=-1) if single else 0.0)
+                value = value + sum(b.sum(axis=(0, 2)) for b in slot_blocks if len(b) > 1)
             return jnp.stack([value, *profiled], axis=-1) if levels else value
-
-        def summed(matrix):
-            # profiled levels need every row's residuals at once
-            return summed_over(matrix, whole) if levels else sum(summed_over(matrix, r) for r in parts)
 
         return pointwise if which == 0 else in_cache_sized_chunks(summed, self.numbers_per_set)
 
-    def _rows_of(self, evaluate, rows) -> "Rows":
-        """The data of ``rows`` (a slice or indices) as constants of the compiled function (as arguments they would be
-        handled on every call), with the model's evaluation there."""
-        return Rows(evaluate=evaluate, size=len(np.arange(len(self.data))[rows]),
-                     y={ch: jnp.asarray(v[rows]) for ch, v in self._y.items()},
-                     errors={ch: jnp.asarray(e[rows]) for ch, e in self._errors.items()},
-                     profiles={ch: jnp.asarray(f[rows]) for ch, f in self._profile.items()})
+    def _residuals(self, groups, total, dop, rows: Rows) -> list:
+        """Each channel group's residuals at ``rows`` from the model's (total, dop) there, (channels, P or 1, N or 1),
+        in ``self.observables``' order."""
+        prediction = Prediction.from_total(total if rows.signs is None else total * rows.signs, dop, self.needs_mueller)
+        out, predicted = [], {}
+        for o, channels in groups:
+            if len(channels) > 1:  # one array for the group (``Observable.predict_stacked``)
+                observed = jnp.stack([rows.y[ch] for ch in channels])[:, None, :]
+                out.append(o.residual(channels[0], observed, o.predict_stacked(prediction), self.inferred(channels[0])))
+                continue
+            ch = channels[0]
+            if ch not in predicted:
+                predicted.update(o.predict(prediction))
+            out.append(o.residual(ch, rows.y[ch], predicted[ch], self.inferred(ch))[None])
+        return out
 
-    def _profiled(self, levels, groups, resids, n_sets, errors, profiles) -> list:
-        """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals)."""
+    def _log_densities(self, groups, values: dict, resids: list, rows: Rows, n_sets: int) -> list:
+        """Each channel group's log-likelihood at ``rows``, (channels, P, rows), 0 where a slot holds no row."""
+        out = []
+        for (_, channels), resid in zip(groups, resids):
+            # each channel's noise as (P or 1, N or 1), stacked over the group's channels
+            scales = [jnp.asarray(rows.errors[ch] if ch in rows.errors
+                                  else values[self.noise_parameter(ch)] * rows.profiles.get(ch, 1.0)) for ch in channels]
+            scales = [jnp.broadcast_to(sc, jnp.broadcast_shapes(sc.shape, (1, 1))) for sc in scales]
+            lp = self._logpdf(channels[0], resid, jnp.stack(jnp.broadcast_arrays(*scales)))
+            lp = jnp.broadcast_to(lp, (len(channels), n_sets, rows.size))
+            out.append(lp if rows.valid is None else jnp.where(rows.valid, lp, 0.0))
+        return out
+
+    def _profiled(self, levels, groups, resids, slots, n_sets) -> list:
+        """Each level of ``levels`` at its conditional maximum (the RMS of its channels' scaled residuals over every
+        slot's rows)."""
         out = []
         for name, lower, upper in levels:
             squares, count = 0.0, 0
-            for (_, channels), resid in zip(groups, resids):
-                for c, ch in enumerate(channels):
-                    if ch not in errors and self.noise_parameter(ch) == name:
-                        z = resid[c] / profiles.get(ch, 1.0)
-                        squares = squares + jnp.sum(jnp.broadcast_to(z, (n_sets, len(self.data))) ** 2, axis=-1)
-                        count += len(self.data)
+            for rows, slot_resids in zip(slots, resids):
+                held = rows.size if rows.valid is None else int(np.sum(np.asarray(rows.valid)))
+                for (_, channels), resid in zip(groups, slot_resids):
+                    for c, ch in enumerate(channels):
+                        if ch not in rows.errors and self.noise_parameter(ch) == name:
+                            z2 = jnp.broadcast_to(resid[c] / rows.profiles.get(ch, 1.0), (n_sets, rows.size)) ** 2
+                            squares = squares + jnp.sum(z2 if rows.valid is None else jnp.where(rows.valid, z2, 0.0), axis=-1)
+                            count += held
             out.append(jnp.clip(jnp.sqrt(squares / count), lower, upper))
         return out
 

@@ -1,13 +1,15 @@
 """How the compiled likelihood is cut up: parameter sets into the block sizes it compiles, into chunks that keep
-the intermediates in the CPU's cache, and the rows into the parts it sums one by one (``Rows``).
+the intermediates in the CPU's cache, and the rows into the parts it sums one by one, each in the slots of its mirror
+fold (``Rows``, ``part_slots``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import jax
+import jax.numpy as jnp
+import numpy as np
 
 CACHE_NUMBERS = 1 << 19  # sets x geometries x (16 or 4) numbers evaluated at once by ``total`` (4 MB per array)
 # every likelihood compiles one block of 16 sets (and the callers' exact sizes, e.g. emcee's half-ensemble); a call of
@@ -44,14 +46,43 @@ def block_rows(n_sets: int, sizes: list) -> int:
 
 @dataclass(frozen=True)
 class Rows:
-    """Rows of the data the compiled likelihood takes together: the model there (values -> (total, dop)), the
-    measured values, the file's errors and the noise profiles per channel, and how many rows."""
+    """Rows of the data the compiled likelihood takes together (one wavelength's, or one slot of its mirror fold): how
+    many, the measured values, the file's errors and the noise profiles per channel; for a slot, the signs that turn
+    each folded geometry's Mueller matrix (or Stokes vector) into its row's, and which entries hold a row."""
 
-    evaluate: Callable
     size: int
     y: dict
     errors: dict
     profiles: dict
+    signs: object = None
+    valid: object = None
+
+
+def part_slots(y: dict, errors: dict, profiles: dict, program, j: int, mueller: bool) -> tuple[list[Rows], np.ndarray | None]:
+    """Part ``j`` of ``program``'s data (``y``, ``errors``, ``profiles``: {channel: (N,)}) as the compiled function's
+    constants (as arguments they would be handled on every call): one ``Rows`` per slot of its mirror fold (one
+    holding every row where it has none), and where each of the part's rows lies in its slots laid side by side
+    (None: in order)."""
+    rows, fold = program.part_rows(j), program.folds[j]
+    if fold is None:
+        return [_rows(y, errors, profiles, rows)], None
+    slots = []
+    for held in fold.slots:
+        # where a slot holds no row its numbers are those of the class's first row, and weigh nothing
+        stand_in = np.where(held >= 0, held, fold.slots[0])
+        slots.append(_rows(y, errors, profiles, rows[stand_in], fold.signs(held, mueller), held >= 0))
+    position = np.empty(rows.size, int)
+    for k, held in enumerate(fold.slots):
+        position[held[held >= 0]] = k * held.size + np.flatnonzero(held >= 0)
+    return slots, position
+
+
+def _rows(y: dict, errors: dict, profiles: dict, rows: np.ndarray, signs=None, valid=None) -> Rows:
+    return Rows(size=rows.size, y={ch: jnp.asarray(v[rows]) for ch, v in y.items()},
+                errors={ch: jnp.asarray(e[rows]) for ch, e in errors.items()},
+                profiles={ch: jnp.asarray(f[rows]) for ch, f in profiles.items()},
+                signs=None if signs is None else jnp.asarray(signs),
+                valid=None if valid is None or valid.all() else jnp.asarray(valid))
 
 
 def in_cache_sized_chunks(summed, numbers_per_set: int):

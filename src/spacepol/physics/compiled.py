@@ -21,6 +21,7 @@ from .arrays import array_module
 from .effects.specular import Specular
 from .effect import Context, DepolarizedLobe, Effect, Ratio
 from .geometry import Geometry
+from .mirror import MirrorFold
 from .plugin_guard import is_plugin
 
 _JITTED: dict = {}
@@ -187,9 +188,10 @@ class Program:
     """A Model's or SpectralModel's evaluation over all rows of one geometry as a pure function of traced
     parameter values: ``program(values, program.inputs) -> (total, dop)`` in the rows' order; with
     ``up_to_scale`` the total is right only up to a positive factor per element (``evaluate_values``), for
-    callers that use nothing but ratios of its elements."""
+    callers that use nothing but ratios of its elements. With ``fold``, rows that are each other's mirror images
+    are evaluated once (``physics.mirror``)."""
 
-    def __init__(self, model, geometry: Geometry, mueller: bool, up_to_scale: bool = False):
+    def __init__(self, model, geometry: Geometry, mueller: bool, up_to_scale: bool = False, fold: bool = False):
         ensure_double_precision()
         inner = model.inner
         self.effects, self.defaults, self.mueller, self.up_to_scale = inner.effects, inner.defaults(), mueller, up_to_scale
@@ -197,22 +199,28 @@ class Program:
         self.size = geometry.size
         order = np.concatenate([np.arange(geometry.size)[rows] for rows, _, _ in self.parts])
         self.inverse = None if np.array_equal(order, np.arange(geometry.size)) else jnp.asarray(np.argsort(order))
-        self.inputs = [sub.device_terms() for _, sub, _ in self.parts]
+        symmetric = fold and all(e.mirror_symmetric for e in self.effects)
+        # per part, its mirror fold (None: every row evaluated; ``part`` then gives every row)
+        self.folds = [MirrorFold.of(sub) if symmetric else None for _, sub, _ in self.parts]
+        self.inputs = [(sub if f is None else f.geometry).device_terms() for (_, sub, _), f in zip(self.parts, self.folds)]
 
     def part_rows(self, j: int) -> np.ndarray:
         """The rows of the data (indices) that part ``j`` evaluates, in the order of its output."""
         return np.arange(self.size)[self.parts[j][0]]
 
     def part(self, j: int, values: dict, inputs):
-        """Part ``j`` alone (one wavelength of a SpectralModel): (total, dop) at ``part_rows(j)``. A caller that
+        """Part ``j`` alone (one wavelength of a SpectralModel): (total, dop) at ``part_rows(j)``, or at its mirror
+        fold's geometries where it has one (``folds[j]``: ``fold`` and every effect ``mirror_symmetric``). A caller that
         reduces over rows (the likelihood's sum) takes the parts one by one: concatenated, XLA on a CPU fused the
         X"""
-        (_, sub, inner_values), terms = self.parts[j], inputs[j]
+        (_, sub, inner_values), terms, fold = self.parts[j], inputs[j], self.folds[j]
         return evaluate_values(self.effects, {**self.defaults, **inner_values(values)}, batch_of(values),
-                               Geometry.from_terms(terms, sub.all_visible), self.mueller, self.up_to_scale)
+                               Geometry.from_terms(terms, (sub if fold is None else fold.geometry).all_visible),
+                               self.mueller, self.up_to_scale)
 
     def __call__(self, values: dict, inputs):
-        outputs = [self.part(j, values, inputs) for j in range(len(self.parts))]
+        outputs = [self.part(j, values, inputs) if f is None else f.unfold(*self.part(j, values, inputs), self.mueller)
+                   for j, f in enumerate(self.folds)]
         if len(outputs) == 1:
             return outputs[0]
         total = jnp.concatenate([t for t, _ in outputs], axis=-1)

@@ -130,6 +130,8 @@ class Effect:
     * ``splits``: {own parameter: model parameter it refines} (anisotropy's sigma_x starts at sigma);
     * ``branches``: parameter subsets worth a separate optimiser search (a dielectric's k = 0 is a
       sliver of the k prior that a global search otherwise misses);
+    * ``mirror_symmetric``: it keeps an isotropic sample's mirror symmetry, M(-dphi) = D M(dphi) D (``physics.mirror``):
+      the likelihood of a model of such effects evaluates it once per mirror pair of the data; False unless it says so;
     * ``intensity``: the parameter that scales this effect's lobe (DOP, a ratio of intensities,
       measures only ratios of such parameters: the identifiability report says so);
     * ``applicable(data)``: why the effect cannot be used with these data (None if it can);
@@ -142,6 +144,9 @@ class Effect:
     excludes: tuple[str, ...] = ()
     removes: tuple[str, ...] = ()  # parameters of other effects this one makes unused
     reciprocal: bool = True  # does it keep M(i -> r) = Q M(r -> i)^T Q ?
+    # does it keep M(-dphi) = D M(dphi) D (an isotropic sample's mirror image, ``physics.mirror``)? A plug-in must say
+    # so itself: the likelihood then evaluates the model once per mirror pair of the data
+    mirror_symmetric: bool = False
     description: str = ""
     slot: str | None = None
     substitutes: tuple[str, ...] = ()
@@ -213,7 +218,8 @@ _STAGES = {"lobe", "specular_factor", "modify_specular", "modify_stokes", "modif
 
 
 def effect(name: str, *, stage: str, parameters=(), requires=(), description: str = "", reciprocal: bool = True,
-           slot: str | None = None, removable: bool = False, twins=None, neutral=None, separated_by=None):
+           slot: str | None = None, removable: bool = False, twins=None, neutral=None, separated_by=None,
+           mirror_symmetric: bool = False):
     """Decorator that turns a function into an effect class.
 
     ``stage`` names the hook the function implements; it is called as ``fn(ctx, ...)`` with
@@ -240,6 +246,7 @@ def effect(name: str, *, stage: str, parameters=(), requires=(), description: st
             "requires": tuple(requires),
             "description": description or (fn.__doc__ or "").strip(),
             "reciprocal": reciprocal,
+            "mirror_symmetric": mirror_symmetric,
             "slot": slot,
             "removable": removable,
             "twins": dict(twins or {}),

@@ -12,6 +12,7 @@ from ..parameter import Parameter
 class Body(Effect):
     """The ``body`` effect: the paper's depolarized body term, cos(theta_r) rho_d / pi."""
     name = "body"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     parameters = (
         Parameter("rho_d", "", Uniform(0.0, 1.0), 0.1, "Kubelka-Munk body reflectance rho_d (eq 12)", physical=(0.0, 1.0)),
     )

@@ -10,6 +10,7 @@ from ..parameter import Parameter
 class Depolarization(Effect):
     """The ``depolarization`` effect: a fraction of the specular lobe depolarized, its intensity kept."""
     name = "depolarization"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"d_spec": 0.2}, {"d_spec": 0.6})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("d_spec", "", Uniform(0.0, 1.0), 0.1, "fraction of the specular lobe depolarized", physical=(0.0, 1.0)),

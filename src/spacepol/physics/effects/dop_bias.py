@@ -12,6 +12,7 @@ from ..parameter import Parameter
 class DopBias(Effect):
     """The ``dop_bias`` effect: the Rician bias of a DOP estimated from noisy Stokes parameters."""
     name = "dop_bias"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"bias": 0.01}, {"bias": 0.05})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("bias", "", Uniform(0.0, 0.2), 0.02, "noise floor of the DOP estimator", physical=(0.0, 1.0)),

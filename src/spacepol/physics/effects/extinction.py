@@ -10,6 +10,7 @@ from ..parameter import Parameter
 class Extinction(Effect):
     """The ``extinction`` effect: an analyser with a finite extinction ratio (S1, S2, S3 scaled)."""
     name = "extinction"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"e": 0.9}, {"e": 0.7})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("e", "", Uniform(0.5, 1.0), 0.95, "analyser efficiency: measured DOP = e x true DOP", physical=(0.0, 1.0)),

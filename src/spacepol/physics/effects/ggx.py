@@ -8,6 +8,7 @@ from ..effect import Effect
 class GGX(Effect):
     """The ``ggx`` effect: Trowbridge-Reitz facet slopes in place of Gaussian ones."""
     name = "ggx"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({}, {})  # a small and a large value, for the hidden-effect suite
     requires = ("specular",)
     description = (

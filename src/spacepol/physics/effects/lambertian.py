@@ -13,6 +13,7 @@ from ..parameter import Parameter
 class Lambertian(Effect):
     """The ``lambertian`` effect: depolarized Lambertian reflection, rho_l / pi."""
     name = "lambertian"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"rho_l": 0.05}, {"rho_l": 0.3})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("rho_l", "", Uniform(0.0, 1.0), 0.1, "albedo of the depolarized Lambertian diffuse light", physical=(0.0, 1.0)),

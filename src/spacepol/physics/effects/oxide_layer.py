@@ -13,6 +13,7 @@ from ..parameter import Parameter
 class OxideLayer(Effect):
     """The ``oxide_layer`` effect: a thin transparent film on the facets (Airy reflection coefficients)."""
     name = "oxide_layer"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"thickness_um": 0.05, "n_film": 1.46}, {"thickness_um": 0.25, "n_film": 1.7})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("thickness_um", "um", Uniform(0.0, 1.0), 0.05, "film thickness", physical=(0.0, np.inf)),

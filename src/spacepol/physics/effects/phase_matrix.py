@@ -32,6 +32,7 @@ class PhaseMatrix(SingleScattering):
     """The ``phase_matrix`` effect: first-order volume scattering with a free-form, realizable phase matrix under
     an interface of its own index."""
     name = "phase_matrix"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = (  # a small and a large value, for the hidden-effect suite
         {"w_pm": 0.5, "g_pm": 0.3, "n_pm": 1.3, "pm_m22_0": 0.9, "pm_m22_60": 0.6, "pm_m12_60": -0.5, "pm_m22_120": 0.5,
          "pm_m12_120": -0.4},

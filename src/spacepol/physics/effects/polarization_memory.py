@@ -28,6 +28,7 @@ def retention(f_mem, c_mem):
 class PolarizationMemory(Effect):
     """The ``polarization_memory`` effect: Lambertian light keeping part of its linear and circular polarization."""
     name = "polarization_memory"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     parameters = (
         Parameter("rho_mem", "", Uniform(0.0, 1.0), 0.1, "albedo of the diffuse light that keeps part of its polarization",
                   physical=(0.0, 1.0)),

@@ -13,6 +13,7 @@ from ..parameter import Parameter
 class PolarizedDiffuse(Effect):
     """The ``polarized_diffuse`` effect: refracted in, depolarized, refracted out (Fresnel transmission twice)."""
     name = "polarized_diffuse"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"rho_pd": 0.05}, {"rho_pd": 0.3})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("rho_pd", "", Uniform(0.0, 1.0), 0.1, "albedo of the subsurface Lambertian light", physical=(0.0, 1.0)),

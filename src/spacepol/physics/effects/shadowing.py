@@ -13,6 +13,7 @@ from ..shadowing import PAPER_CONSTANTS, paper_shadowing
 class Shadowing(Effect):
     """The ``shadowing`` effect: the paper's empirical shadowing/masking of the specular lobe."""
     name = "shadowing"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     parameters = tuple(
         Parameter(name, "", Uniform(lo, hi), PAPER_CONSTANTS[name], text, fixed=True, physical=(0.0, np.inf))
         for name, lo, hi, text in [

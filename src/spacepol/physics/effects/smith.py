@@ -12,6 +12,7 @@ from ..effect import Effect
 class Smith(Effect):
     """The ``smith`` effect: Smith's uncorrelated shadowing-masking for the specular lobe's facet statistics."""
     name = "smith"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     excludes = ("shadowing",)
     requires = ("specular",)
     description = (

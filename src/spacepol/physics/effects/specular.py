@@ -14,6 +14,7 @@ from ..parameter import Parameter
 class Specular(Effect):
     """The ``specular`` effect: microfacet reflection with the exact Fresnel Mueller matrix."""
     name = "specular"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     essential = True  # every other lobe and modifier is defined relative to it
     parameters = (
         Parameter("n", "", Uniform(0.1, 5.0), 1.5, "real part of the complex refractive index N = n + ik", physical=(1e-6, np.inf)),

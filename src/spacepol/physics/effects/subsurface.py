@@ -15,6 +15,7 @@ from ..parameter import Parameter
 class Subsurface(Effect):
     """The ``subsurface`` effect: a Lambertian material under a smooth transparent interface (SCATMECH's model)."""
     name = "subsurface"
+    mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
     hidden_values = ({"rho_s": 0.2}, {"rho_s": 0.7})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("rho_s", "", Uniform(0.0, 1.0), 0.3, "albedo of the diffusely scattering material under the surface",

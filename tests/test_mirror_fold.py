@@ -98,19 +98,6 @@ def test_no_fold_without_pairs_or_with_an_asymmetric_effect(rng):
     assert Program(model, paired, True, fold=True).folds == [None]
 
 
-def test_a_subset_of_every_fourth_geometry_keeps_its_mirror_pairs(rng):
-    """The global search's row subset (``MirrorFold.rows_of_every``): every fourth of the 48 folded geometries with
-    all its rows, so the subset folds as the whole does; a row and its mirror image are in it together or not at all."""
-    ti, tr, dphi = _paired_geometry(rng)
-    geometry = Geometry(ti, tr, dphi)
-    rows = MirrorFold.rows_of_every(geometry, 4)
-    key = [(a, b, round(min(d % 360, 360 - d % 360), 9)) for a, b, d in zip(ti, tr, dphi)]
-    chosen = {key[j] for j in rows}
-    assert len(chosen) == 12 and all((key[j] in chosen) == (j in set(rows)) for j in range(ti.size))
-    sub = Geometry(ti[rows], tr[rows], dphi[rows])
-    assert MirrorFold.of(sub).geometry.size == 12 < len(rows)
-
-
 def test_the_folded_likelihood_is_the_unfolded_one(rng, monkeypatch):
     """Noisy Mueller data (inferred noise levels, a noise profile) at mirror pairs, repeated rows and unpaired rows over
     two wavelengths: the likelihood folded into slots gives every row's pointwise value, the total and the profiled

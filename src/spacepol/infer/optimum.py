@@ -12,7 +12,6 @@ from .differentiable import cube_objective
 from .engines.de import run_de
 from .objective import NegativeLogPosterior
 from .posterior import PinnedPosterior, Posterior
-from ..physics.mirror import MirrorFold
 from ..priors import Fixed
 from .profiled import ProfiledPosterior
 
@@ -120,14 +119,13 @@ def find_optimum_profiled(posterior: Posterior, rng: np.random.Generator, evalua
 
 def find_optimum_on_every(posterior: Posterior, every: int, rng: np.random.Generator,
                           evaluations: int = 4000) -> tuple[float, np.ndarray]:
-    """``find_optimum_profiled`` on the rows of every ``every``-th geometry of the data (with its mirror image where
-    that was measured, ``MirrorFold.rows_of_every``: the likelihood folds such pairs; same model and priors), its
-    optimum then polished on all rows: (max log posterior, parameter vector). Where the rows are many more than the
-    optimum's position needs (PTFE at four wavelengths: 7,296 geometries x 16 numbers), the global search's cost falls
-    with the rows; ``every`` <= 1 is ``find_optimum_profiled`` itself."""
+    """``find_optimum_profiled`` on every ``every``-th row of the data (same model and priors), its optimum then
+    polished on all rows: (max log posterior, parameter vector). Where the rows are many more than the optimum's
+    position needs (PTFE at four wavelengths: 7,296 geometries x 16 numbers), the global search's cost falls with
+    the rows; ``every`` <= 1 is ``find_optimum_profiled`` itself."""
     if every <= 1:
         return find_optimum_profiled(posterior, rng, evaluations)
-    coarse = posterior.on_rows(MirrorFold.rows_of_every(posterior.likelihood.geometry, every))
+    coarse = posterior.on_rows(np.arange(0, len(posterior.likelihood.data), every))
     _, theta = find_optimum_profiled(coarse, rng, evaluations)
     return polish_posterior(posterior, theta)
 

@@ -69,13 +69,6 @@ class MirrorFold:
         index = jnp.asarray(self.index)
         return total[..., index] * jnp.asarray(signs), dop[..., index]
 
-    @staticmethod
-    def rows_of_every(geometry: Geometry, every: int) -> np.ndarray:
-        """The rows of every ``every``-th class (a geometry with its mirror image; a class of one where the image was
-        not measured), in the data's order: a subset that costs a folded likelihood about 1/``every`` of the whole
-        and keeps the pairs (every ``every``-th row would split them and leave nothing to fold)."""
-        return np.flatnonzero(_classes(geometry)[3] % every == 0)
-
 
 def _classes(geometry: Geometry):
     """Per row its folded dphi (deg) and whether it is the mirror image; the first row of each class; each row's class."""

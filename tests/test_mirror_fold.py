@@ -133,3 +133,32 @@ def test_the_folded_likelihood_is_the_unfolded_one(rng, monkeypatch):
     assert np.max(np.abs(a - b)) < 1e-10 * np.max(np.abs(b)) and np.allclose(a_total, b_total, rtol=1e-11)
     assert np.allclose(a_max, b_max, rtol=1e-11) and all(np.allclose(a_levels[k], b_levels[k], rtol=1e-11) for k in b_levels)
     assert np.ptp(b_total) > 1.0  # the sets differ
+
+
+def test_the_folded_likelihood_of_dop_aop_and_brdf_is_the_unfolded_one(rng, monkeypatch):
+    """Stokes observables at mirror pairs: the AoP changes sign in the mirror (S2 does), the DOP and BRDF do not; the
+    folded likelihood gives the unfolded one's pointwise values (AoP's noise inferred, growing as 1 / DOP)."""
+    from spacepol.infer.likelihood import Likelihood
+    from spacepol.io.measurements import Dataset
+    from spacepol.physics import mirror
+
+    ti, tr, dphi = _paired_geometry(rng)
+    geometry = Geometry(ti, tr, dphi, np.full(ti.size, 0.63))
+    model = Model.from_string("specular+smith+polarized_diffuse")
+    truth = _random_params(model, rng)
+    predicted = model.evaluate(truth, geometry)
+    data = Dataset(ti, tr, dphi, wavelength_um=geometry.wavelength_um)
+    data.dop, data.dop_err = predicted.dop + 0.01 * rng.standard_normal(ti.size), np.full(ti.size, 0.01)
+    data.brdf, data.brdf_err = predicted.brdf * (1 + 0.02 * rng.standard_normal(ti.size)), 0.02 * predicted.brdf
+    data.aop = predicted.aop_deg + rng.standard_normal(ti.size)
+    data.source = "mirror pairs, Stokes"
+    sets = {**{k: np.full(3, v) for k, v in truth.items()}, "sigma_aop_deg": np.array([0.5, 1.0, 2.0])}
+    outputs = {}
+    for fold in (True, False):
+        monkeypatch.setattr(mirror, "MIN_SAVED", 0.1 if fold else 1.1)
+        likelihood = Likelihood(data, model, observables=["dop", "aop", "brdf"])
+        outputs[fold] = (likelihood.pointwise(sets), [None if f is None else f.geometry.size
+                                                       for f in likelihood._program.folds])
+    (a, a_folds), (b, b_folds) = outputs[True], outputs[False]
+    assert a_folds == [48] and b_folds == [None]
+    assert np.max(np.abs(a - b)) < 1e-10 * np.max(np.abs(b)) and np.ptp(b.sum(axis=1)) > 1.0

@@ -28,6 +28,7 @@ from ..physics.parameter import Parameter
 from .likelihood_blocks import (BLOCK_SETS, LARGE_BLOCK_SETS, ONE_BLOCK_NUMBERS, POINTWISE_NUMBERS, SETS_PAYING_A_COMPILATION,
                                 SETS_PAYING_THE_SUM, Rows, block_rows, in_cache_sized_chunks, part_slots)
 
+
 def select_observables(data: Dataset, names=None) -> tuple[list, dict[str, str]]:
     """The Observable objects to fit and ``{observable in the data not fitted: the fitted one holding its
     numbers}``: those named (aliases such as q, u allowed; nothing left out), or by default every observable

@@ -55,8 +55,8 @@ class MirrorFold:
         return cls(geometry=kept, slots=slots, flipped=flipped, index=index)
 
     def signs(self, rows: np.ndarray, mueller: bool) -> np.ndarray:
-        """Per row of ``rows`` (-1: none, +1 given) the signs that turn its class's Mueller matrix (4, 4, 1, n) or
-        Stokes vector (4, 1, n) into its own."""
+        """For ``rows`` (row indices, -1 where a slot holds none) the signs that turn each class's Mueller matrix
+        (4, 4, 1, n) or Stokes vector (4, 1, n) into its row's (1 where there is no row)."""
         signs = np.outer(MIRROR_SIGNS, MIRROR_SIGNS) if mueller else MIRROR_SIGNS
         flipped = np.where(rows >= 0, self.flipped[np.maximum(rows, 0)], False)
         return np.where(flipped, signs[..., None], 1.0)[..., None, :]

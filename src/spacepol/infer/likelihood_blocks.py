@@ -43,7 +43,6 @@ def block_rows(n_sets: int, sizes: list) -> int:
     return below[-1]
 
 
-
 @dataclass(frozen=True)
 class Rows:
     """Rows of the data the compiled likelihood takes together (one wavelength's, or one slot of its mirror fold): how

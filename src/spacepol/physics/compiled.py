@@ -212,7 +212,7 @@ class Program:
         """Part ``j`` alone (one wavelength of a SpectralModel): (total, dop) at ``part_rows(j)``, or at its mirror
         fold's geometries where it has one (``folds[j]``: ``fold`` and every effect ``mirror_symmetric``). A caller that
         reduces over rows (the likelihood's sum) takes the parts one by one: concatenated, XLA on a CPU fused the
-        X"""
+        four wavelengths' evaluations into one loop over all rows and ran at half their separate speed."""
         (_, sub, inner_values), terms, fold = self.parts[j], inputs[j], self.folds[j]
         return evaluate_values(self.effects, {**self.defaults, **inner_values(values)}, batch_of(values),
                                Geometry.from_terms(terms, (sub if fold is None else fold.geometry).all_visible),

@@ -12,7 +12,7 @@ from spacepol.infer.inversion import laplace_fit
 from spacepol.infer.laplace import laplace_importance
 from spacepol.infer.optimum import find_optimum
 from spacepol.infer.posterior import Posterior
-from spacepol.infer.spread_check import BOUNDED_K, MAX_SD_GROWTH, spread_check
+from spacepol.infer.spread_check import BOUNDED_K, EARLY_LOOKS, MAX_SD_GROWTH, STEPS, spread_check
 from spacepol.io import read_measurements
 from spacepol.paths import bundled
 from spacepol.physics import Model
@@ -70,7 +70,7 @@ def test_right_draws_keep_their_width_under_the_walkers(paper_set, seed):
     check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0], skip_bounded=False)
     name, widest = check.widest
     assert widest < MAX_SD_GROWTH - 0.03, f"{name}'s SD grew {widest:.3f}x (limit {MAX_SD_GROWTH}): {check.to_json()}"
-    assert check.refusal == ""
+    assert check.refusal == "" and check.steps == STEPS  # no early look refuses right draws: the whole run decides
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -100,6 +100,8 @@ def test_the_dop_ridges_trusted_draws_are_refused_by_the_walkers_spread_too():
     check = spread_check(post, sample, np.random.default_rng(6).spawn(1)[0])
     growth = dict(zip(check.names, check.ratios))
     assert growth["n"] > MAX_SD_GROWTH + 0.2, growth
+    # refused part-way: the walkers had spread far beyond the draws at one of the early looks
+    assert check.steps in EARLY_LOOKS and check.clearly_refused and check.refusal, (check.steps, growth)
 
 
 def test_the_laplace_engine_falls_back_to_emcee_and_says_so(tmp_path):

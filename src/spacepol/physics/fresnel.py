@@ -43,9 +43,19 @@ def _a_b2(n, k, sin2_theta):
     sum (sqrt(C) + |D|)/2 is computed as written and the other from the product, so weak absorption
     (B^2 ~ n^2 k^2 / D, which the difference loses to rounding) keeps every digit, with one division.
     """
+    a, b = _a_b(n, k, sin2_theta)
+    return a, b * b
+
+
+def _a_b(n, k, sin2_theta):
+    """A and B of eqs 16-19 (N cos(theta_t) = A + iB), without cancellation and with finite derivatives: the larger
+    of the two is sqrt(big) (``_larger_half``), the other |n k| / sqrt(big), so no square root is taken of a
+    number that can be 0 (B at k = 0, A under total reflection), whose derivative would be infinite (times a zero
+    derivative inside it: NaN in a gradient)."""
     nk2, big, above = _larger_half(n, k, sin2_theta)
-    small = nk2 / jnp.where(big > 0, big, 1.0)  # big = 0 only where n = k = 0 and sin = 0
-    return jnp.sqrt(jnp.where(above, big, small)), jnp.where(above, small, big)
+    root = jnp.sqrt(jnp.where(big > 0, big, 1.0))  # big = 0 only where n = k = 0 and sin = 0
+    other = jnp.where(big > 0, jnp.abs(n * k) / root, 0.0)
+    return jnp.where(above, root, other), jnp.where(above, other, root)
 
 
 def _larger_half(n, k, sin2_theta):
@@ -110,7 +120,7 @@ def interface_matrix_entries(n, k, cos_theta, sin2_theta, scale=1.0):
     """``matrix_entries`` of a bare interface onto N = n + ik, in real arithmetic, times ``scale``.
 
     The same numbers as ``matrix_entries(*amplitudes(...))``, about 3x faster compiled: complex square roots
-    and divisions are slow on a CPU. N cos(theta_t) = A + iB comes from eqs 16-19 (``_a_b2``: Re and Im of the
+    and divisions are slow on a CPU. N cos(theta_t) = A + iB comes from eqs 16-19 (``_a_b``: Re and Im of the
     principal root), then r_s = (c - A - iB) / (c + A + iB), r_p = (N^2 c - A - iB) / (N^2 c + A + iB), and all
     four entries share one division by |D_s|^2 |D_p|^2.
 
@@ -118,8 +128,7 @@ def interface_matrix_entries(n, k, cos_theta, sin2_theta, scale=1.0):
     (sets x geometries) array for both, and the Mueller matrix's loop, which reads its stored inputs once for
     each of the 16 elements, reads three instead of four (memory-bound at 64 sets x 100,000 geometries:
     41-46 -> 51-55 M evaluations/s; 4,096 x 84: 81-91 -> 100-106, interleaved in one process)."""
-    a, b2 = _a_b2(n, k, sin2_theta)
-    b = jnp.sqrt(b2)
+    a, b = _a_b(n, k, sin2_theta)
     eps_re, eps_im = n * n - k * k, 2.0 * n * k  # N^2
     num_s_re, num_s_im = cos_theta - a, -b
     den_s_re, den_s_im = cos_theta + a, b

@@ -97,10 +97,9 @@ def _is_zero(x) -> bool:
 def _transmission_amplitudes(n, k, cos_t):
     """Fresnel amplitude transmission (t_s, t_p) from vacuum into N = n + ik at external angle theta, each as
     (real, imaginary), in real arithmetic: t_s = 2 c / (c + N cos(theta_t)), t_p = 2 N c / (N^2 c + N cos(theta_t)),
-    with N cos(theta_t) = A + iB the principal root (``fresnel._a_b2``)."""
+    with N cos(theta_t) = A + iB the principal root (``fresnel._a_b``)."""
     sin2 = 1.0 - cos_t * cos_t
-    a, b2 = fresnel._a_b2(n, k, sin2)
-    b = jnp.sqrt(b2)
+    a, b = fresnel._a_b(n, k, sin2)
     ds_re, ds_im = cos_t + a, b
     inv_s = 2.0 * cos_t / (ds_re * ds_re + ds_im * ds_im)
     t_s = (ds_re * inv_s, -ds_im * inv_s)

@@ -189,6 +189,8 @@ def test_the_multistart_with_exact_gradients_reaches_the_finite_difference_maxim
     term, its noise levels profiled: the multistart polished by exact JAX gradients ends at the same maximum as the
     one polished by finite differences from the same Sobol points (the margin is printed). Control: a scan of the
     prior alone is far below."""
+    from scipy.stats import qmc
+
     from spacepol.infer.optimum import multistart
     from spacepol.infer.profiled import ProfiledPosterior
     from spacepol.io import read_measurements
@@ -200,7 +202,5 @@ def test_the_multistart_with_exact_gradients_reaches_the_finite_difference_maxim
     exact, _ = multistart(post, np.random.default_rng(0), gradient=True)
     finite, _ = multistart(post, np.random.default_rng(0), gradient=False)
     assert abs(exact - finite) < 1.0, f"exact gradients {exact:.2f}, finite differences {finite:.2f}"
-    from scipy.stats import qmc
-
     scan = post.log_prob(post.priors.rescale(qmc.Sobol(post.ndim, rng=np.random.default_rng(1)).random(256)))
     assert np.max(scan) < exact - 100, (np.max(scan), exact)

@@ -36,22 +36,15 @@ def film_amplitudes(N_substrate, n_film, thickness_um, wavelength_um, cos_theta,
     return r_s, r_p
 
 
-def _a_b2(n, k, sin2_theta):
-    """A and B^2 of eqs 16-19, without cancellation.
-
-    A^2 = (sqrt(C) + D)/2 and B^2 = (sqrt(C) - D)/2 with A^2 B^2 = n^2 k^2: the one of the two that is a
-    sum (sqrt(C) + |D|)/2 is computed as written and the other from the product, so weak absorption
-    (B^2 ~ n^2 k^2 / D, which the difference loses to rounding) keeps every digit, with one division.
-    """
-    a, b = _a_b(n, k, sin2_theta)
-    return a, b * b
-
-
 def _a_b(n, k, sin2_theta):
-    """A and B of eqs 16-19 (N cos(theta_t) = A + iB), without cancellation and with finite derivatives: the larger
-    of the two is sqrt(big) (``_larger_half``), the other |n k| / sqrt(big), so no square root is taken of a
-    number that can be 0 (B at k = 0, A under total reflection), whose derivative would be infinite (times a zero
-    derivative inside it: NaN in a gradient)."""
+    """A and B of eqs 16-19 (N cos(theta_t) = A + iB), without cancellation and with finite derivatives.
+
+    A^2 = (sqrt(C) + D)/2 and B^2 = (sqrt(C) - D)/2 with A B = |n k|: the one of the two that is a sum,
+    sqrt(big) with big = (sqrt(C) + |D|)/2 (``_larger_half``), is computed as written and the other as |n k| /
+    sqrt(big), so weak absorption (B^2 ~ n^2 k^2 / D, which the difference loses to rounding) keeps every digit, and
+    no square root is taken of a number that can be 0 (B at k = 0, A under total reflection), whose derivative would
+    be infinite (times a zero derivative inside it: NaN in a gradient).
+    """
     nk2, big, above = _larger_half(n, k, sin2_theta)
     root = jnp.sqrt(jnp.where(big > 0, big, 1.0))  # big = 0 only where n = k = 0 and sin = 0
     other = jnp.where(big > 0, jnp.abs(n * k) / root, 0.0)
@@ -69,7 +62,7 @@ def power_terms(n, k, cos_theta, sin2_theta, sin_tan_theta):
     """R_s = N_s / D_s and R_p = R_s N_p / D_p (eqs 14-19, corrected eq 15) as the four sums of squares,
     without a division: (N_s, D_s, N_p, D_p), each > 0 (D) or >= 0 (N).
 
-    Each sum is eqs 16-19's (A -+ x)^2 + B^2 times A^2 + B^2's larger half ``big`` (``_a_b2``), which makes
+    Each sum is eqs 16-19's (A -+ x)^2 + B^2 times A^2 + B^2's larger half ``big`` (``_a_b``), which makes
     every term a product: with s = sqrt(big), s A is big (above, D >= 0) or |n k| (below), and big B^2 is
     n^2 k^2 or big^2. The common factor cancels in each ratio, and a caller that needs the reflectances only
     up to a positive factor (DOP: ``compiled``'s up-to-scale programs) divides nowhere. ``big`` = 0 (n = k = 0,
@@ -101,7 +94,8 @@ def power(n, k, cos_theta, sin2_theta, sin_tan_theta):
 
 def power_paper_eq15(n, k, cos_theta, sin2_theta):
     """The paper's printed eq 15 (sin*cos instead of sin*tan).  Wrong; kept for a regression test."""
-    a, b2 = _a_b2(n, k, sin2_theta)
+    a, b = _a_b(n, k, sin2_theta)
+    b2 = b * b
     r_s = ((a - cos_theta) ** 2 + b2) / ((a + cos_theta) ** 2 + b2)
     sin_cos = jnp.sqrt(sin2_theta) * cos_theta
     r_p = r_s * ((a - sin_cos) ** 2 + b2) / ((a + sin_cos) ** 2 + b2)

@@ -472,6 +472,9 @@ def main(argv=None) -> int:
                         "every n-th row only, then polished on all rows (8 for the whole file at four wavelengths)")
     parser.add_argument("--out", default="reports/ptfe_models")
     args = parser.parse_args(argv)
+    from spacepol import configure_process
+
+    configure_process(small_calls=True)  # the settings the command line makes, its compiled programs kept on disk
     data = load(args.wavelength_um)
     try:  # every model named, with its options, before any work
         for spec in args.models.split(","):

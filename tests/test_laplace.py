@@ -185,11 +185,12 @@ def test_weights_collapsed_onto_the_mode_of_a_ridge_are_refused():
     it is refused, and says why (that its Pareto k and effective draws alone may pass, so that the width is what
     refuses it, is the slow test below); diagnose's fit then samples with emcee and keeps the reason. Control: ``paper`` on the same data, where the approximation holds, keeps every coordinate's
     width (ratio >= 0.9)."""
-    from spacepol.infer.laplace import MIN_WIDTH_RATIO
+    from spacepol.infer.laplace import MIN_WIDTH_RATIO, WIDTH_EFFECTIVE_DRAWS
     from spacepol.infer.optimum import multistart
 
     data, ridge, centre = _ridge_and_centre()
-    sample = laplace_importance(ridge, centre, np.random.default_rng(2))
+    # as the engine draws them (topped up where the walkers would compare SDs)
+    sample = laplace_importance(ridge, centre, np.random.default_rng(2), width_draws=WIDTH_EFFECTIVE_DRAWS)
     assert sample is not None and not sample.reliable and sample.width_ratio < 0.65 < MIN_WIDTH_RATIO, sample.width_ratio
     # diagnose's fit falls back to emcee and keeps the refusal, which says why (the same seed: the same draws)
     from spacepol.criticism.candidate_fits import fit_for_elpd

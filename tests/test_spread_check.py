@@ -9,7 +9,7 @@ import pytest
 import spacepol
 from ridges import METAL, band_data, band_posterior
 from spacepol.infer.inversion import laplace_fit
-from spacepol.infer.laplace import laplace_importance
+from spacepol.infer.laplace import WIDTH_EFFECTIVE_DRAWS, laplace_importance
 from spacepol.infer.optimum import find_optimum
 from spacepol.infer.posterior import Posterior
 from spacepol.infer.spread_check import BOUNDED_K, EARLY_LOOKS, MAX_SD_GROWTH, STEPS, spread_check
@@ -35,7 +35,8 @@ def test_draws_trusted_by_pareto_k_on_a_curved_band_are_refused_by_the_walkers_s
     post, centre = metal_band
     growths, errors = [], []
     for seed in range(1, 7):
-        sample = laplace_importance(post, centre, np.random.default_rng(seed))
+        # as the engine draws them: topped up to ``WIDTH_EFFECTIVE_DRAWS`` where the walkers compare SDs
+        sample = laplace_importance(post, centre, np.random.default_rng(seed), width_draws=WIDTH_EFFECTIVE_DRAWS)
         assert sample is not None and sample.reliable, "the control: the weights' own checks trust these draws"
         assert sample.pareto_k > BOUNDED_K + 0.2, f"k {sample.pareto_k:.2f}: the walkers run on this band"
         check = spread_check(post, sample, np.random.default_rng(seed).spawn(1)[0])

@@ -20,7 +20,7 @@ from .diagnostics import PARETO_K_LIMIT, loo_fields
 from .posterior import Posterior
 from .psis import logsumexp_rows, psis_log_weights
 from .sampling_space import SamplingSpace
-from .spread_check import weighted_sd
+from .spread_check import BOUNDED_K, weighted_sd
 
 MIN_EFFECTIVE_DRAWS = 400  # as emcee's ESS target
 PROPOSAL_DF = 5.0
@@ -28,7 +28,12 @@ ADAPTATIONS = 8  # at most this many moment-matching steps of the declared-param
 # the weighted draws' SD of each coordinate in the sampling space z, over the Laplace SD there, below which the weights
 # are taken to have collapsed onto the mode (see the module's step 6)
 MIN_WIDTH_RATIO = 0.75
-MAX_DRAWS = 10000  # the last proposal, trusted (Pareto k <= 0.7) but short of 400 effective draws, is drawn from up to this many
+MAX_DRAWS = 10000  # a trusted proposal short of the effective draws wanted is drawn from again, up to this many in all
+# effective draws wanted where the walkers will compare SDs with the draws' (Pareto k above ``BOUNDED_K``): every ratio
+# carries the draws' own SD error, ~1 / sqrt(2 x effective draws) (3 % at 528, PTFE's four wavelengths from 2,000
+# draws), and the widest of many ratios then reaches the check's undecided band with right draws; at 1,500 it is
+# ~2 %, below the walkers' own SE (``benchmarks-log``: PTFE, 27 parameters: widest 1.052 from 528, 1.037 from 1,662)
+WIDTH_EFFECTIVE_DRAWS = 1500
 
 
 def _trusted(pareto_k: float, effective_draws: float) -> bool:
@@ -190,6 +195,22 @@ def _draw(proposal, log_density, draws, rng):
     return x, log_p, np.where(np.isfinite(raw), raw, -np.inf)
 
 
+def _topped_up(proposal, log_density, drawn: tuple, rng, draws: int, width_draws: float):
+    """``drawn`` ((x, log_p, raw) from ``proposal``) with ``draws`` more at a time while its weights are trusted by
+    Pareto k but short of the effective draws wanted, up to ``MAX_DRAWS`` in all: ``MIN_EFFECTIVE_DRAWS``, and
+    ``width_draws`` where the walkers will compare SDs (k above ``BOUNDED_K``). Returns (x, log_p, raw, weights)."""
+    x, log_p, raw = drawn
+    weights = _smoothed(raw)
+    while weights is not None and weights[1] <= PARETO_K_LIMIT and len(raw) + draws <= MAX_DRAWS:
+        wanted = max(MIN_EFFECTIVE_DRAWS, width_draws if weights[1] > BOUNDED_K else 0.0)
+        if weights[2] >= wanted:
+            break
+        more = _draw(proposal, log_density, draws, rng)
+        x, log_p, raw = (np.concatenate([a, b]) for a, b in zip((x, log_p, raw), more))
+        weights = _smoothed(raw)
+    return x, log_p, raw, weights
+
+
 def mode_and_precision(log_prob_z, z0: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The mode of the batched log density ``log_prob_z`` nearest ``z0`` and minus its Hessian there (central
     differences, each step half the axis's own width from a first pass with steps of 1e-2); None where the density
@@ -206,11 +227,14 @@ def mode_and_precision(log_prob_z, z0: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def laplace_importance(posterior: Posterior, centre, rng: np.random.Generator, draws: int = 2000,
-                       df: float = PROPOSAL_DF, adapt: bool = True) -> ImportanceSample | None:
+                       df: float = PROPOSAL_DF, adapt: bool = True, width_draws: float = 0.0) -> ImportanceSample | None:
     """Importance draws near the posterior, started from ``centre`` (an optimum in the declared parameters): a
     Student-t at the mode in the logit-CDF space with the Laplace covariance; where its weights are not reliable
     (and ``adapt``), an adapted t mixture in the declared parameters (the module's steps 3-4), returned where the first is not reliable, even if it is not either. None where the mode's Hessian is
-    not negative definite or the log posterior is not finite there. The caller checks ``reliable``."""
+    not negative definite or the log posterior is not finite there. The caller checks ``reliable``. With
+    ``width_draws`` (the caller's walkers will compare SDs: ``WIDTH_EFFECTIVE_DRAWS``) a proposal trusted by Pareto k
+    but short of 400 effective draws, or of ``width_draws`` where its k is above ``BOUNDED_K``, is drawn from again,
+    ``draws`` at a time."""
     space = SamplingSpace(posterior.priors)
     log_prob_z = space.log_prob(posterior)
     found = mode_and_precision(log_prob_z, space.to_z(np.asarray(centre, float))[0])
@@ -223,8 +247,9 @@ def laplace_importance(posterior: Posterior, centre, rng: np.random.Generator, d
         proposal = _Mixture([multivariate_t(loc=mode, shape=covariance, df=df)], [1.0])
     except (np.linalg.LinAlgError, ValueError):  # not negative definite: no Gaussian approximation here
         return None
-    z, log_p, raw = _draw(proposal, log_prob_z, draws, rng)
-    weights = _smoothed(raw)
+    drawn = _draw(proposal, log_prob_z, draws, rng)
+    z, log_p, raw, weights = (_topped_up(proposal, log_prob_z, drawn, rng, draws, width_draws) if width_draws
+                              else (*drawn, _smoothed(drawn[2])))
     if weights is None:
         return None
     theta_mode = space.to_theta(mode[None, :])[0]
@@ -237,7 +262,7 @@ def laplace_importance(posterior: Posterior, centre, rng: np.random.Generator, d
     sample.width_ratio = _width_ratio(space, sample, laplace_sd)
     if sample.reliable or not adapt:
         return sample
-    adapted = _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df)
+    adapted = _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df, width_draws)
     if adapted is not None:
         adapted.width_ratio = _width_ratio(space, adapted, laplace_sd)
     return sample if adapted is None else adapted  # where neither is reliable, the last attempt (for the caller's message)
@@ -252,7 +277,8 @@ def _width_ratio(space: SamplingSpace, sample: ImportanceSample, laplace_sd: np.
     return float(np.min(weighted_sd(z[keep], sample.log_weights[keep]) / laplace_sd))
 
 
-def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df) -> ImportanceSample | None:
+def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws, df,
+                      width_draws: float = 0.0) -> ImportanceSample | None:
     """The declared-parameter proposal (module step 4): the z-space Laplace covariance carried to theta by the
     delta method, then ``ADAPTATIONS`` moment-matching steps, each a t mixed half and half with what came before."""
     eps = 1e-6
@@ -263,19 +289,14 @@ def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws
         return None
     log_density = posterior.log_prob
     for step in range(ADAPTATIONS + 1):
-        theta, log_p, raw = _draw(proposal, log_density, draws, rng)
+        drawn = _draw(proposal, log_density, draws, rng)
+        theta, log_p, raw = drawn
         weights = _smoothed(raw)
         if weights is None:
             return None
-        if _trusted(weights[1], weights[2]):
-            break
-        if step == ADAPTATIONS:
-            # the last proposal, drawn from again while its weights are trusted but short of 400 effective draws
-            while (weights is not None and weights[1] <= PARETO_K_LIMIT and weights[2] < MIN_EFFECTIVE_DRAWS
-                   and len(raw) + draws <= MAX_DRAWS):
-                more = _draw(proposal, log_density, draws, rng)
-                theta, log_p, raw = (np.concatenate([a, b]) for a, b in zip((theta, log_p, raw), more))
-                weights = _smoothed(raw)
+        if _trusted(weights[1], weights[2]) or step == ADAPTATIONS:
+            # the last proposal, or the first trusted one, drawn from again while short of the effective draws wanted
+            theta, log_p, raw, weights = _topped_up(proposal, log_density, drawn, rng, draws, width_draws)
             break
         w = np.exp(weights[0])
         mean = w @ theta

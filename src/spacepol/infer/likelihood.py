@@ -183,6 +183,12 @@ class Likelihood:
         evaluated here would have paid for the fused program's compilation (``SETS_PAYING_THE_SUM``)."""
         return self._call(1, params)
 
+    def expect_sets(self, n_sets: int) -> None:
+        """A caller about to evaluate ``n_sets`` parameter sets by ``total`` (a sampler's whole run): counted as
+        evaluated, so that a large likelihood compiles its fused program at once where they would pay for it
+        (``SETS_PAYING_THE_SUM``) instead of reaching it through the pointwise program."""
+        self._sets_in_total_calls += n_sets
+
     @property
     def profilable(self) -> list[str]:
         """The inferred noise levels whose conditional maximum is closed-form (Gaussian noise: the RMS of the

@@ -129,6 +129,7 @@ def spread_check(posterior, sample, rng: np.random.Generator, steps: int = STEPS
     walkers = walkers or max(MIN_WALKERS, default_walkers(ndim))
     if hasattr(getattr(posterior, "likelihood", None), "exact_sizes"):
         posterior.likelihood.exact_sizes.add(walkers // 2)  # emcee evaluates half the ensemble at a time
+        posterior.likelihood.expect_sets(walkers * steps)
     log_prob = space.log_prob(posterior)
     sampler = emcee.EnsembleSampler(walkers, ndim, log_prob, vectorize=True, moves=ridge_moves())
     sampler.log_prob_fn = log_prob  # called directly: emcee's wrapper prints every walker on an exception

@@ -11,7 +11,7 @@ import numpy as np
 from ..draws_result import summarised
 from ..engine_result import EngineResult
 from ..inference_data import batched, to_inference_data
-from ..laplace import importance_loo, laplace_importance, scale_ridge
+from ..laplace import WIDTH_EFFECTIVE_DRAWS, importance_loo, laplace_importance, scale_ridge
 from ..posterior import Posterior
 from ..result import Result
 from ..spread_check import spread_check
@@ -41,7 +41,7 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
     if ridge:
         return None, ridge
     rng = np.random.default_rng(seed)
-    sample = laplace_importance(posterior, centre, rng, draws=draws)
+    sample = laplace_importance(posterior, centre, rng, draws=draws, width_draws=WIDTH_EFFECTIVE_DRAWS)
     if sample is None:
         return None, NO_LAPLACE
     if not sample.reliable:
@@ -66,8 +66,10 @@ def laplace_fit(posterior: Posterior, centre, seed: int = 0, draws: int = 2000) 
                     log_prob=sample.log_prob[kept][:, None], info=info)
     idata = to_inference_data(result, posterior, rng, draws)
     lik = posterior.likelihood
-    log_likelihood = batched(posterior.log_prob_pointwise, sample.theta, lik.batch_sets)
-    loo_result = importance_loo(log_likelihood, sample.raw_log_weights, lik.labels)
+    # PSIS-LOO from the first ``draws`` draws (independent draws of one proposal, as all of them are): more draws drawn
+    # for the walkers' check would multiply the pointwise evaluation on a large data set
+    log_likelihood = batched(posterior.log_prob_pointwise, sample.theta[:draws], lik.batch_sets)
+    loo_result = importance_loo(log_likelihood, sample.raw_log_weights[:draws], lik.labels)
     diagnostics = {"engine": "laplace-is", "rhat_max": None, "ess_min": sample.effective_draws, "tau_max": None,
                    "acceptance": None, "pareto_k": sample.pareto_k, "sd_growth_max": spread.widest[1]}
     return summarised(posterior, result, idata, loo_result, diagnostics, seed, start), ""

@@ -31,8 +31,8 @@ MIN_WIDTH_RATIO = 0.75
 MAX_DRAWS = 10000  # a trusted proposal short of the effective draws wanted is drawn from again, up to this many in all
 # effective draws wanted where the walkers will compare SDs with the draws' (Pareto k above ``BOUNDED_K``): every ratio
 # carries the draws' own SD error, ~1 / sqrt(2 x effective draws) (3 % at 528, PTFE's four wavelengths from 2,000
-# draws), and the widest of many ratios then reaches the check's undecided band with right draws; at 1,500 it is
-# ~2 %, below the walkers' own SE (``benchmarks-log``: PTFE, 27 parameters: widest 1.052 from 528, 1.037 from 1,662)
+# draws), and the widest of many ratios then reaches the check's undecided band with right draws more often; at 1,500
+# it is ~2 %, at most the walkers' own SE after 2,000 steps (the internals page)
 WIDTH_EFFECTIVE_DRAWS = 1500
 
 

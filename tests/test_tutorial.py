@@ -54,7 +54,7 @@ def test_tutorial_recovers_the_truth_and_its_round_trip_uses_the_runs_own_n_and_
         np.testing.assert_allclose(again.samples()[name], values, rtol=1e-12)
     assert again.diagnostics == result.diagnostics and again.log_evidence == result.log_evidence
     # Laplace-IS gives the evidence where its checks trust it; emcee, where they refuse it, none
-    assert (result.log_evidence is not None) == (result.diagnostics.engine == "laplace"), result.summary.laplace_refused
+    assert (result.log_evidence is not None) == (result.diagnostics.engine == "laplace-is"), result.summary.laplace_refused
     assert "interpolated" in table.material["rule"] and table.material["wavelength_um"] == 0.8
 
     # the target DOP the contrast should find, computed here from the loaded draws: n, k interpolated linearly in

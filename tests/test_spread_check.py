@@ -91,6 +91,25 @@ def test_bounded_weights_need_no_walkers(paper_set, seed):
     assert result.summary.diagnostics["sd_growth_max"] is None
 
 
+def test_draws_are_topped_up_only_where_the_walkers_compare_sds(metal_band, paper_set):
+    """Where the walkers will run (Pareto k above ``BOUNDED_K``: the metal band) the engine's proposal is drawn from
+    again, 2,000 at a time, until ``WIDTH_EFFECTIVE_DRAWS`` effective draws or ``MAX_DRAWS``; the first 2,000 are the
+    draws of a run without it. Where the weights are bounded (the paper set) nothing more is drawn. Control: without
+    ``width_draws`` the metal band's sample stays at 2,000 draws, short of the target."""
+    from spacepol.infer.laplace import MAX_DRAWS
+
+    post, centre = metal_band
+    plain = laplace_importance(post, centre, np.random.default_rng(3))
+    topped = laplace_importance(post, centre, np.random.default_rng(3), width_draws=WIDTH_EFFECTIVE_DRAWS)
+    assert len(plain.theta) == 2000 and plain.effective_draws < WIDTH_EFFECTIVE_DRAWS, plain.effective_draws
+    assert plain.pareto_k > BOUNDED_K + 0.2 and len(topped.theta) % 2000 == 0 and len(topped.theta) > 2000
+    assert topped.effective_draws >= WIDTH_EFFECTIVE_DRAWS or len(topped.theta) + 2000 > MAX_DRAWS, topped.effective_draws
+    np.testing.assert_array_equal(topped.theta[:2000], plain.theta)
+    post, centre = paper_set
+    bounded = laplace_importance(post, centre, np.random.default_rng(0), width_draws=WIDTH_EFFECTIVE_DRAWS)
+    assert bounded.pareto_k <= BOUNDED_K and len(bounded.theta) == 2000, (bounded.pareto_k, len(bounded.theta))
+
+
 def test_the_dop_ridges_trusted_draws_are_refused_by_the_walkers_spread_too():
     """The DOP-only ridge (refused before any draw by ``scale_ridge``): its proposals that Pareto k trusts would be
     refused by the spread as well, with a growth in n far above the limit."""

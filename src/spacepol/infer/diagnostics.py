@@ -85,11 +85,11 @@ def loo_fields(pointwise: np.ndarray, pareto_k: np.ndarray, p_loo: float, labels
             "pareto_k_bad": [labels[i] for i in np.flatnonzero(pareto_k > PARETO_K_LIMIT)], "pointwise": pointwise}
 
 
-def fit_statistics(posterior: Posterior, result: EngineResult, loo_result: dict) -> dict:
+def fit_statistics(posterior: Posterior, result: EngineResult, loo_result: dict, median: tuple | None = None) -> dict:
     """RMSE of DOP (also when DOP is not fitted but measured: a Mueller fit predicts it) and reduced chi^2
-    at the posterior-median prediction."""
+    at the posterior-median prediction; ``median``: ``median_fit`` of the result's draws where already computed."""
     lik = posterior.likelihood
-    mu, scale = median_fit(posterior, result.flat_samples())
+    mu, scale = median or median_fit(posterior, result.flat_samples())
     chi2 = sum(float(np.sum(lik.standardise(o, mu[o], scale[o]) ** 2)) for o in lik.observables)
     rmse = None
     if lik.data.dop is not None:

@@ -12,7 +12,7 @@ from ..physics.model_spec import spec_of
 from .diagnostics import convergence, fit_statistics, loo, quantile_dict, quantiles
 from .engine_result import EngineResult
 from .identifiability import identifiability
-from .inference_data import to_inference_data
+from .inference_data import median_fit, to_inference_data
 from .posterior import Posterior
 from .result import Result
 from .run_summary import RunSummary
@@ -30,6 +30,7 @@ def summarised(posterior: Posterior, result: EngineResult, idata, loo_result: di
                start: float) -> Result:
     """The Result of a posterior's draws: summary (quantiles, fit, noise ratios, identifiability, residual
     structure) and the ArviZ groups."""
+    median = median_fit(posterior, result.flat_samples())  # the fit statistics' and the residual analysis' prediction
     summary = RunSummary(
         model=posterior.likelihood.model.name,
         # the whole model: what contrast rebuilds
@@ -37,7 +38,7 @@ def summarised(posterior: Posterior, result: EngineResult, idata, loo_result: di
         parameters=quantiles(result),
         engine=diagnostics["engine"],  # what drew the posterior (emcee where the Laplace engine was refused)
         diagnostics=diagnostics,
-        fit=fit_statistics(posterior, result, loo_result),
+        fit=fit_statistics(posterior, result, loo_result, median),
         seconds=time.perf_counter() - start,
         seed=seed,
         observables=posterior.likelihood.observables,
@@ -68,7 +69,7 @@ def summarised(posterior: Posterior, result: EngineResult, idata, loo_result: di
     summary.identifiability = {k: ident[k] for k in ("weak", "correlated_pairs", "at_bound", "findings", "width_ratio")}
     from .residuals import analyse
 
-    structure = analyse(posterior, result.flat_samples())
+    structure = analyse(posterior, result.flat_samples(), median)
     summary.residual_structure = {"runs": structure.runs, "lag1": structure.lag1, "findings": structure.findings(),
                                      "structured": structure.structured()}
     return Result(posterior, result, idata, summary, loo_result, ident)

@@ -101,11 +101,12 @@ def lag1(residuals, groups) -> float:
     return float(np.corrcoef(a, b)[0, 1])
 
 
-def analyse(posterior, samples) -> ResidualReport:
+def analyse(posterior, samples, median: tuple | None = None) -> ResidualReport:
     """The ResidualReport of the posterior-median fit: standardised residuals per observable, runs test and lag-1
-    correlation along the theta_r sweeps, rank correlations with the angles and the DOP level."""
+    correlation along the theta_r sweeps, rank correlations with the angles and the DOP level; ``median``:
+    ``median_fit`` of ``samples`` where already computed."""
     data = posterior.likelihood.data
-    mu, scale = median_fit(posterior, samples)
+    mu, scale = median or median_fit(posterior, samples)
     res = {o: posterior.likelihood.standardise(o, mu[o], scale[o]) for o in posterior.likelihood.observables}
     geo = data.geometry
     phase = np.degrees(np.arccos(np.clip(np.sum(geo.k_i * geo.k_r, axis=-1), -1, 1)))

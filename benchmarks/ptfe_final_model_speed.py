@@ -42,14 +42,6 @@ def timed(module, name: str, phases: dict, label: str) -> None:
     setattr(module, name, wrapper)
 
 
-def cache_folder() -> Path:
-    folder = os.environ.get("SPACEPOL_CACHE_DIR")
-    if folder is None:
-        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-        folder = os.path.join(base, "spacepol", "jax")
-    return Path(folder)
-
-
 def cpu_name() -> str:
     try:
         return next(line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
@@ -63,7 +55,9 @@ def main() -> int:
     ap.add_argument("--search-every", type=int, default=8)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    folder = cache_folder()
+    from spacepol._runtime import compilation_cache_folder
+
+    folder = Path(compilation_cache_folder() or os.devnull)  # "": the cache turned off, nothing held
     held = len(list(folder.glob("*"))) if folder.is_dir() else 0  # before anything is compiled
     from spacepol import configure_process
 

@@ -124,16 +124,23 @@ def ensure_double_precision() -> None:
         jax.config.update("jax_enable_x64", True)
 
 
+def compilation_cache_folder() -> str:
+    """Where compiled programs are kept: $SPACEPOL_CACHE_DIR, else $XDG_CACHE_HOME/spacepol/jax or
+    ~/.cache/spacepol/jax; "" where SPACEPOL_CACHE_DIR="" turns the cache off."""
+    folder = os.environ.get("SPACEPOL_CACHE_DIR")
+    if folder is None:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        folder = os.path.join(base, "spacepol", "jax")
+    return folder
+
+
 def configure_jax() -> None:
     """Wide vectors where the CPU has them, double precision, and compiled programs kept on disk."""
     prefer_wide_vectors()  # before JAX creates its CPU backend, which reads XLA_FLAGS once
     import jax
 
     jax.config.update("jax_enable_x64", True)
-    folder = os.environ.get("SPACEPOL_CACHE_DIR")
-    if folder is None:
-        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-        folder = os.path.join(base, "spacepol", "jax")
+    folder = compilation_cache_folder()
     if not folder:
         return
     try:

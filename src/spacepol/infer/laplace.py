@@ -195,12 +195,12 @@ def _draw(proposal, log_density, draws, rng):
     return x, log_p, np.where(np.isfinite(raw), raw, -np.inf)
 
 
-def _topped_up(proposal, log_density, drawn: tuple, rng, draws: int, width_draws: float):
-    """``drawn`` ((x, log_p, raw) from ``proposal``) with ``draws`` more at a time while its weights are trusted by
-    Pareto k but short of the effective draws wanted, up to ``MAX_DRAWS`` in all: ``MIN_EFFECTIVE_DRAWS``, and
-    ``width_draws`` where the walkers will compare SDs (k above ``BOUNDED_K``). Returns (x, log_p, raw, weights)."""
+def _topped_up(proposal, log_density, drawn: tuple, weights, rng, draws: int, width_draws: float):
+    """``drawn`` ((x, log_p, raw) from ``proposal``, ``weights`` its ``_smoothed``) with ``draws`` more at a time while
+    its weights are trusted by Pareto k but short of the effective draws wanted, up to ``MAX_DRAWS`` in all:
+    ``MIN_EFFECTIVE_DRAWS``, and ``width_draws`` where the walkers will compare SDs (k above ``BOUNDED_K``). Returns
+    (x, log_p, raw, weights)."""
     x, log_p, raw = drawn
-    weights = _smoothed(raw)
     while weights is not None and weights[1] <= PARETO_K_LIMIT and len(raw) + draws <= MAX_DRAWS:
         wanted = max(MIN_EFFECTIVE_DRAWS, width_draws if weights[1] > BOUNDED_K else 0.0)
         if weights[2] >= wanted:
@@ -248,8 +248,9 @@ def laplace_importance(posterior: Posterior, centre, rng: np.random.Generator, d
     except (np.linalg.LinAlgError, ValueError):  # not negative definite: no Gaussian approximation here
         return None
     drawn = _draw(proposal, log_prob_z, draws, rng)
-    z, log_p, raw, weights = (_topped_up(proposal, log_prob_z, drawn, rng, draws, width_draws) if width_draws
-                              else (*drawn, _smoothed(drawn[2])))
+    z, log_p, raw, weights = (*drawn, _smoothed(drawn[2]))
+    if width_draws:
+        z, log_p, raw, weights = _topped_up(proposal, log_prob_z, drawn, weights, rng, draws, width_draws)
     if weights is None:
         return None
     theta_mode = space.to_theta(mode[None, :])[0]
@@ -296,7 +297,7 @@ def _adapted_in_theta(posterior, space, mode, theta_mode, covariance, rng, draws
             return None
         if _trusted(weights[1], weights[2]) or step == ADAPTATIONS:
             # the last proposal, or the first trusted one, drawn from again while short of the effective draws wanted
-            theta, log_p, raw, weights = _topped_up(proposal, log_density, drawn, rng, draws, width_draws)
+            theta, log_p, raw, weights = _topped_up(proposal, log_density, drawn, weights, rng, draws, width_draws)
             break
         w = np.exp(weights[0])
         mean = w @ theta

@@ -11,8 +11,9 @@ each: ``PHASES``; they nest, so the phases overlap where one calls another, e.g.
 The sets: (a) NIST's PTFE at 0.633 um, the plane of incidence, full Mueller matrix and BRDF; (b) the bundled 84-point
 DOP + BRDF set with a hidden effect. For each: the wall time of `invert` (emcee to convergence, the default of
 `invert-mcmc run`) and of `diagnose --rounds` (the default posterior, Laplace-IS where trusted), the split of the
-first round into base fit, screening and confirmation, the path, the ratio; the machine, its cores and the load
-average before and after. The run goes first, so that it pays the compilations it shares with diagnose.
+first round into base fit, screening and confirmation, the path, the ratio, a table of every round's and the slot
+pass's base fit, screening, leaders' multistarts and refits (from the record's ``seconds_rounds`` and
+``seconds_slot_pass``); the machine, its cores and the load average before and after. The run goes first, so that it pays the compilations it shares with diagnose.
 """
 
 from __future__ import annotations
@@ -52,6 +53,27 @@ def phase_table(profile: cProfile.Profile) -> list[tuple[str, float]]:
     return out
 
 
+def round_table(content: dict, total_s: float) -> list[str]:
+    """Where the diagnosis's time went, from its own record (no profiler): per round and for the last pass over the
+    slot alternatives, the base fit, the screening, the leaders' global multistarts and the refits (their posteriors and
+    PSIS-LOO); the rest (building the record and the rungs) as the remainder of ``total_s``."""
+    passes = [(f"round {i + 1}", s) for i, s in enumerate(content.get("seconds_rounds", []))]
+    if content.get("seconds_slot_pass"):
+        passes.append(("slot pass", content["seconds_slot_pass"]))
+    if not passes:
+        return []
+    lines = [f"  {'':<10s} {'base fit':>9s} {'screening':>10s} {'leaders':>8s} {'refits':>8s} {'refitted':>8s}"]
+    sums = np.zeros(4)
+    for name, s in passes:
+        row = np.array([s["base_fit"], s["screening"], s["leader_search"], s["confirmation"] - s["leader_search"]])
+        sums += row
+        lines.append(f"  {name:<10s} " + " ".join(f"{v:{w}.1f}" for v, w in zip(row, (9, 10, 8, 8)))
+                     + f" {s['candidates_refitted']:8d}")
+    lines.append(f"  {'all':<10s} " + " ".join(f"{v:{w}.1f}" for v, w in zip(sums, (9, 10, 8, 8)))
+                 + f"; the rest {total_s - sums.sum():.1f} s of {total_s:.1f} s")
+    return lines
+
+
 def sets() -> dict:
     """The two data sets by name."""
     return {"ptfe": lambda: spacepol.load(bundled("ptfe", "ptfe_mueller_brdf.csv"), wavelength_um=0.633, in_plane=True),
@@ -87,6 +109,8 @@ def main() -> None:
               f"--rounds {args.rounds} {diagnose_s:.1f} s (round 1: base fit {first.get('base_fit', np.nan):.0f} s, "
               f"screening {first.get('screening', np.nan):.0f} s, confirmation {first.get('confirmation', np.nan):.0f} s); "
               f"path {path}; ratio {diagnose_s / run_s:.2f} (goal <= 4)", flush=True)
+        for line in round_table(found.content, diagnose_s):
+            print(line)
         if profile:
             for phase, seconds in phase_table(profile):
                 print(f"  {phase:<50s} {seconds:8.1f} s ({100 * seconds / diagnose_s:4.0f} %)")

@@ -403,3 +403,42 @@ def test_dominance_needs_a_gap_beyond_its_standard_error_and_margin():
     assert found and found["dominance_delta"] == pytest.approx(60.0)
     assert not _dominated(candidate(), leader(10.0, 0.2))
     assert not _dominated(candidate(), leader(60.0, 2.0))
+
+
+def test_a_leader_search_or_refit_asked_for_again_is_not_done_again(monkeypatch):
+    """Within one ``CandidateFits`` (diagnose --rounds keeps one for all rounds), a leader search or a refit of the same
+    model with the same arguments is done once and its result handed out again (an earlier round's model among the
+    slot alternatives); the base fit done in this process counts too. Controls: another model, another start, and
+    screening (whose answer depends on the start diagnose keeps in ``searched``) are done each time."""
+    from spacepol.criticism import candidate_fits
+    from spacepol.criticism.candidate_fits import CandidateFits
+    from spacepol.io import read_measurements
+    from spacepol.paths import bundled
+    from spacepol.physics import Model
+
+    done = []
+
+    def task(kind):
+        def run(post, *args):
+            done.append((kind, post.likelihood.model.name))
+            return object()
+        return run
+
+    for kind in ("screen", "leader", "refit"):
+        monkeypatch.setitem(candidate_fits.TASKS, kind, task(kind))
+    data = read_measurements(bundled("synthetic", "hidden_effect.csv"))
+    fits, rng = CandidateFits(data), np.random.default_rng(0)
+    paper, other = Model.from_string("paper"), Model.from_string("paper+lambertian")
+    jobs = [(paper, fits.posterior(paper)), (other, fits.posterior(other))]
+    first = dict(fits.run("leader", jobs, rng))
+    again = dict(fits.run("leader", jobs[:1], rng))
+    assert again[0] is first[0] and fits.recalled(again[0]) and not fits.recalled(first[1])
+    assert done == [("leader", "specular+shadowing+body"), ("leader", "specular+shadowing+body+lambertian")]
+    start = np.array([1.5, 0.0, 0.2, 0.5, 0.3])
+    base = fits.once("refit", paper, (start, 0, 100, "laplace"), lambda: "the base fit")
+    refit = dict(fits.run("refit", [(paper, jobs[0][1], start.copy(), 0, 100, "laplace"),
+                                    (paper, jobs[0][1], start + 0.01, 0, 100, "laplace")], rng))
+    assert refit[0] == base and refit[1] != base and done[-1] == ("refit", "specular+shadowing+body")
+    for _ in range(2):
+        list(fits.run("screen", jobs[:1], rng))
+    assert done[-2:] == [("screen", "specular+shadowing+body")] * 2

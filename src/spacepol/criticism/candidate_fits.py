@@ -114,6 +114,19 @@ def _leader(post, seed: int) -> tuple[float, np.ndarray]:
 
 
 TASKS = {"screen": _screen, "leader": _leader, "refit": fit_for_elpd}
+# the tasks whose result is a function of the model, its arguments and its seed alone (the same for the same model
+# within one ``CandidateFits``): done once, however often the rounds ask (a screening's answer depends on where it
+# starts, kept already by diagnose's ``searched``)
+REMEMBERED = ("leader", "refit")
+
+
+def task_key(kind: str, model, args: tuple) -> tuple | None:
+    """What identifies a task of ``REMEMBERED`` kind among those done (None for the others): its kind, the model
+    (``model_key``) and its arguments, arrays by their bytes."""
+    if kind not in REMEMBERED:
+        return None
+    return kind, model_key(model), tuple(np.asarray(a, float).tobytes() if isinstance(a, np.ndarray) else a
+                                         for a in args)
 
 _WORKER_KEEPS = 4  # posteriors a worker keeps
 _WORKER: dict = {}  # in a worker process: the data and the fitting settings, sent once
@@ -168,6 +181,8 @@ class CandidateFits:
         self.data, self.observables, self.priors = data, observables, priors
         self.workers = max(1, int(workers))
         self._pool, self._root = None, None
+        self._done: dict = {}  # {task_key: result} of the deterministic tasks (``REMEMBERED``) run so far
+        self._recalled: set = set()  # the ids of those results handed out again
 
     def posterior(self, model) -> Posterior:
         """The candidate's posterior in this process, not checked (``Posterior.ensure_checked``) until a task runs
@@ -179,9 +194,39 @@ class CandidateFits:
 
     def run(self, kind: str, jobs: list[tuple], rng: np.random.Generator) -> Iterator[tuple[int, object]]:
         """(index, result) per job, as jobs finish; a job is (model, posterior in this process, args...) and gets as
-        its ``seed`` argument ``task_seed`` of its kind and model (the root drawn from ``rng`` at the first call)."""
+        its ``seed`` argument ``task_seed`` of its kind and model (the root drawn from ``rng`` at the first call). A
+        leader search or refit done before by this object (``task_key``) is not done again: its result is returned."""
         if self._root is None:
             self._root = int(rng.integers(2**63))
+        keys = [task_key(kind, job[0], job[2:]) for job in jobs]
+        todo = []
+        for i, key in enumerate(keys):
+            if key in self._done:
+                self._recalled.add(id(self._done[key]))
+                yield i, self._done[key]
+            else:
+                todo.append(i)
+        for j, out in self._run(kind, [jobs[i] for i in todo]):
+            if keys[todo[j]] is not None:
+                self._done[keys[todo[j]]] = out
+            yield todo[j], out
+
+    def recalled(self, result) -> bool:
+        """Whether ``result`` was handed out again by ``run`` (a task done before), not done for that call."""
+        return id(result) in self._recalled
+
+    def once(self, kind: str, model, args: tuple, compute):
+        """``compute()``, the result of task ``kind`` of ``model`` with ``args`` done in this process (a base fit), kept
+        as ``run`` keeps its tasks': the same task later (a slot alternative equal to an earlier round's model) is not
+        done again."""
+        key = task_key(kind, model, args)
+        if key is None:
+            return compute()
+        if key not in self._done:
+            self._done[key] = compute()
+        return self._done[key]
+
+    def _run(self, kind: str, jobs: list[tuple]) -> Iterator[tuple[int, object]]:
         seeds = [task_seed(self._root, kind, model_key(job[0])) for job in jobs]
         parallel = self.workers > 1 and len(jobs) > 1 and not any(_from_a_file(job[0]) for job in jobs)
         if not parallel:

@@ -139,8 +139,8 @@ def _fit_base(run: _Run, model: Model, base, candidates) -> list:
     run.blind = blind_changes(all_candidates, run.base_post.likelihood.objects)
     if base is None:
         run.say(f"[base] fitting {model.name} ({len(run.data)} geometries) ...")
-        base = fit_for_elpd(run.base_post, _vector(run.base_optimum, run.base_post), run.seed, run.max_steps,
-                            run.posterior_method)
+        args = (_vector(run.base_optimum, run.base_post), run.seed, run.max_steps, run.posterior_method)
+        base = run.fits.once("refit", model, args, lambda: fit_for_elpd(run.base_post, *args))
     run.base = base
     run.clock["base"] = time.perf_counter()
     return [c for c in all_candidates if c not in run.blind]
@@ -240,8 +240,8 @@ def _refit(run: _Run, to_confirm: list[str]) -> list[str]:
         for i, inv in run.fits.run("refit", jobs, run.rng):
             run.update(batch[i], **_refit_fields(inv, run.base, base_fit, run.base_loo))
             refitted.append(batch[i])
-            run.say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {batch[i]}: "
-                    f"{posterior_words(inv)}, {inv.summary.seconds:.0f} s")
+            when = "fitted before, the same model from the same start" if run.fits.recalled(inv) else f"{inv.summary.seconds:.0f} s"
+            run.say(f"[confirm {len(refitted)}/{len(to_confirm) - len(dominated)}] {batch[i]}: {posterior_words(inv)}, {when}")
 
     def front_runner():
         return _front_runner([board[c] for c in refitted])

@@ -61,7 +61,7 @@ def diagnose_rounds(data, model: Model, rng: np.random.Generator, rounds: int, s
 def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progress, priors, base, posterior_method,
             fits, criterion="loo") -> RoundsRecord:
     reports, current = [], model
-    path = []
+    path, slot_pass_seconds = [], None
     searched = {}  # the maxima found for each model screened so far (diagnose's ``searched``)
     for r in range(rounds):
         if progress:
@@ -76,8 +76,9 @@ def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progre
         if report["verdict"] == "none":
             simplification = _simplification(report)
             if simplification is None:
-                equivalent, better = _slot_equivalents(data, current, rng, seed, observables, candidates, progress,
-                                                       priors, report.base, posterior_method, searched, fits)
+                equivalent, better, slot_pass_seconds = _slot_equivalents(
+                    data, current, rng, seed, observables, candidates, progress, priors, report.base, posterior_method,
+                    searched, fits)
                 path[-1] = replace(path[-1], equivalent=tuple(equivalent), better=tuple(better))
                 break
         lead = simplification or next(c for c in report.confirmed if c.verdict == report["verdict"])
@@ -92,7 +93,9 @@ def _rounds(data, model, rng, rounds, seed, observables, candidates, top, progre
             print(f"  round {r + 1}: {lead.label} (delta ELPD {lead.delta_elpd:+.1f} +- {lead.delta_elpd_se:.1f}); "
                   f"{describe_fit(lead.inversion.summary)}", file=sys.stderr, flush=True)
     content = {**reports[0].to_json(), "rounds": path, "final_model": current.name,
-               "conclusion_rounds": _conclusion(path, reports)}
+               "conclusion_rounds": _conclusion(path, reports),
+               # where each round's time went (``seconds`` above is the first round's), and the slot pass's
+               "seconds_rounds": [r["seconds"] for r in reports], "seconds_slot_pass": slot_pass_seconds}
     return RoundsRecord(content, reports)
 
 
@@ -107,16 +110,17 @@ def _simplification(report: DiagnosisRecord) -> CandidateFit | None:
 
 def _slot_equivalents(data, model, rng, seed, observables, candidates, progress, priors, base,
                       posterior_method: str = "laplace", searched: dict | None = None,
-                      fits=None) -> tuple[list[dict], list[dict]]:
+                      fits=None) -> tuple[list[dict], list[dict], dict | None]:
     """Where the path stopped: refit every other member of each of the final model's slots (and the slot
     emptied), and keep those the data cannot tell from the member the model holds. One extra pass, so
     the conclusion can say which parts of the final model the data pin down. Returns (equivalent, better): the
     second, alternatives significantly better than the final model (the pass searches each globally, where the
-    round's screening searched near the model and may have missed their best mode)."""
+    round's screening searched near the model and may have missed their best mode); and the pass's ``seconds`` (None
+    where there was nothing to weigh)."""
     slots = {e.slot for e in model.effects if e.slot}
     labels = slot_alternatives(model, data, slots, candidates)
     if not labels:
-        return [], []
+        return [], [], None
     if progress:
         print(f"  the path stopped at {model.name}: weighing each slot's other members ({len(labels)} refits)",
               file=sys.stderr, flush=True)
@@ -126,7 +130,7 @@ def _slot_equivalents(data, model, rng, seed, observables, candidates, progress,
     report = diagnose(data, model, rng, seed=seed, observables=observables, candidates=names, top=0, progress=progress,
                       priors={k: v for k, v in (priors or {}).items() if k in known}, base=base, confirm=labels,
                       posterior_method=posterior_method, searched=searched, fits=fits)
-    return _equivalent(report, labels), _better(report, labels)
+    return _equivalent(report, labels), _better(report, labels), report["seconds"]
 
 
 def _equivalent(report: DiagnosisRecord, labels) -> list[dict]:

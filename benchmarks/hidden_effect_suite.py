@@ -12,7 +12,9 @@ body term) for E in none, dop_bias, angle_offset, extinction, polarized_diffuse,
 (``spacepol.validation.swap_suite``). Right = the path holds the shadowing swap and E (or a tied
 twin), the nulls gain no addition, and the final reduced chi^2 < 1.5.
 
-Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts). A partial run
+Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts) and
+criticism_verdicts.json (each case's verdict or path: ``tests/data/criticism_verdicts.json`` is such a record, made
+by the code before a change meant to keep them; the slow suite tests compare). A partial run
 (``--effects``, ``--no-swaps``, ``--only-swaps``) updates the cases it ran in an existing
 hidden_effects.json and keeps the others, so one part can be re-measured alone.
 """
@@ -25,6 +27,7 @@ from pathlib import Path
 from spacepol._runtime import spawned_pool
 from spacepol.validation.hidden_effects import run_suite, suite, summarise
 from spacepol.validation.swap_suite import run_swap_case, summarise_swaps, swap_suite
+from spacepol.validation.verdicts import verdicts
 from spacepol.io.atomic import save_figure, write_json
 from spacepol.report.criticism_figures import validation_figure
 
@@ -52,6 +55,7 @@ def main():
     summary = {**(summarise(rows) if rows else {}), **(summarise_swaps(swap_rows) if swap_rows else {})}
     write_json(out / "hidden_effects.json", {"summary": summary, "cases": rows, "swap_cases": swap_rows,
                                              "seconds": {"hidden": seconds_hidden, "total": time.perf_counter() - start}})
+    write_json(out / "criticism_verdicts.json", verdicts(rows, swap_rows))
     save_figure(validation_figure(rows, swap_rows), out / "hidden_effects.png")
     (out / "hidden_effects.md").write_text(_table(rows) + _swap_table(swap_rows) + "\n" + json.dumps(summary, indent=1) + "\n")
     print(json.dumps(summary, indent=1))

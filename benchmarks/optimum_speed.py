@@ -11,7 +11,10 @@ Success: within 0.5 of the best log posterior any search found on that set. Time
 DOP+BRDF set, a DOP+BRDF set with a 0.25 um oxide film (a comb of interference orders), and with
 ``--sets ... ptfe`` the PTFE Mueller set at 0.633 um.
 
-    python benchmarks/optimum_speed.py [--seeds 5] [--sets dop bundled film ptfe]
+    python benchmarks/optimum_speed.py [--seeds 5] [--sets dop bundled bundled-rich film ptfe ptfe-in-plane]
+
+``ptfe-in-plane``: PTFE's in-plane rows with the models diagnose --rounds searches there (up to 37 parameters);
+``bundled-rich``: the 84-point set with a phase-matrix model (more parameters, few numbers).
 """
 
 from __future__ import annotations
@@ -63,6 +66,14 @@ def sets(chosen):
         data = synthetic(film, {"n": 1.2, "k": 7.0, "sigma": 0.15, "ks": 0.8, "rho_d": 0.05, "thickness_um": 0.25,
                                 "n_film": 1.65}, wavelength_um=0.633)
         yield "0.25 um film, paper+oxide_layer", Posterior.build(data, Model.from_string(film))
+    if "ptfe-in-plane" in chosen:  # the models diagnose --rounds searches on PTFE (its leaders' multistarts)
+        data = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633).in_plane()
+        for spec in ("paper", "paper+phase_matrix",
+                     "specular+shadowing+polarized_diffuse+phase_matrix+polarization_memory+volume"):
+            yield f"PTFE 0.633 um in-plane Mueller + BRDF, {spec}", Posterior.build(data, Model.from_string(spec))
+    if "bundled-rich" in chosen:
+        data = read_measurements(bundled("synthetic", "hidden_effect.csv"))
+        yield "bundled hidden_effect.csv, paper+phase_matrix", Posterior.build(data, Model.from_string("paper+phase_matrix"))
     if "ptfe" in chosen:
         data = read_measurements(bundled("ptfe", "ptfe_mueller_brdf.csv")).at_wavelength(0.633)
         yield "PTFE 0.633 um Mueller + BRDF, paper+polarized_diffuse", Posterior.build(
@@ -77,7 +88,7 @@ def de(posterior, rng):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--sets", nargs="+", choices=["dop", "bundled", "film", "ptfe"], default=["dop", "bundled", "film"])
+    parser.add_argument("--sets", nargs="+", choices=["dop", "bundled", "bundled-rich", "film", "ptfe", "ptfe-in-plane"], default=["dop", "bundled", "film"])
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores)")
     searches = {

@@ -1,18 +1,43 @@
 """The validation suite of `diagnose` on data with hidden effects.
 
-The full suite (40 cases) is `slow`; `benchmarks/hidden_effect_suite.py` runs the same
-cases and prints the rates. The default run checks the pieces: the size measure and the suite's
-composition. (`tests/test_diagnose.py` runs a null case and a twin case with the whole library.)
+The full suite (56 cases) and the swap cases are `slow`; `benchmarks/hidden_effect_suite.py` runs the same
+cases and prints the rates. The swap test also compares every case's path with ``data/criticism_verdicts.json``,
+the record the code made before changes meant only to make diagnose faster. The default run checks the pieces: the
+size measure, the suite's composition and the comparison itself.
+(`tests/test_diagnose.py` runs a null case and a twin case with the whole library.)
 """
+
+import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import stats
 
 from spacepol.validation.hidden_effects import HIDDEN_VALUES, Case, effect_size, run_suite, suite, summarise
+from spacepol.validation.verdicts import differences, verdicts
 from spacepol.criticism.changes import changes
 from spacepol.physics import Model
 from spacepol.physics.registry import BUILTIN_EFFECTS
+
+REFERENCE = json.loads((Path(__file__).parent / "data" / "criticism_verdicts.json").read_text())
+
+
+def test_a_verdict_unlike_the_references_is_named_and_the_same_ones_pass():
+    """The comparison the slow test makes: the reference's own answers pass; a changed verdict, a changed path, a
+    case left out and a case the reference lacks are each named (controls)."""
+    hidden = [{"label": f"case {i}", "verdict": "ggx", "tied_with": []} for i in range(3)]
+    reference = {**REFERENCE, "hidden": verdicts(hidden, [])["hidden"]}
+    swaps = [{"label": label, **answer} for label, answer in REFERENCE["swaps"].items()]
+    assert len(swaps) == 12
+    found = verdicts(hidden, swaps)
+    assert differences(found, reference, "hidden") == [] and differences(found, reference, "swaps") == []
+    changed = verdicts([{**hidden[0], "verdict": "a different effect"}] + hidden[2:] + [{**hidden[1], "label": "new"}],
+                       [{**swaps[0], "path": swaps[0]["path"][:-1]}] + swaps[1:])
+    named = differences(changed, reference, "hidden")
+    assert len(named) == 3 and "a different effect" in " ".join(named) and any("missing" in n for n in named)
+    assert any("not in the reference" in n for n in named)
+    assert len(differences(changed, REFERENCE, "swaps")) == 1
 
 
 def test_suite_covers_every_composable_builtin_effect_and_null_sets():
@@ -72,5 +97,7 @@ def test_swap_cases_reach_noise_through_the_right_changes():
     for r in rows:
         print(r["label"], " -> ".join(r["path"]), r["chi2_red_per_round"], r["correct"])
     s = summarise_swaps(rows)
+    changed = differences(verdicts([], rows), REFERENCE, "swaps")
+    assert not changed, changed  # the paths the reference's code took
     assert sum(r["correct"] for r in rows) >= 10, rows
     assert s["swap_null_clean_rate"] == 1.0

@@ -13,7 +13,8 @@ DOP + BRDF set with a hidden effect. For each: the wall time of `invert` (emcee 
 `invert-mcmc run`) and of `diagnose --rounds` (the default posterior, Laplace-IS where trusted), the split of the
 first round into base fit, screening and confirmation, the path, the ratio, a table of every round's and the slot
 pass's base fit, screening, leaders' multistarts and refits (from the record's ``seconds_rounds`` and
-``seconds_slot_pass``); the machine, its cores and the load average before and after. The run goes first, so that it pays the compilations it shares with diagnose.
+``seconds_slot_pass``); the machine, its cores and the load average before and after. The run goes first, so that
+it pays the compilations it shares with diagnose.
 """
 
 from __future__ import annotations

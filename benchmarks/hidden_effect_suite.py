@@ -14,7 +14,7 @@ twin), the nulls gain no addition, and the final reduced chi^2 < 1.5.
 
 Prints one line per case and the rates; writes hidden_effects.json/.md/.png (both parts) and
 criticism_verdicts.json (each case's verdict or path: ``tests/data/criticism_verdicts.json`` is such a record, made
-by the code before a change meant to keep them; the slow suite tests compare). A partial run
+by the code before a change meant to keep them; the slow swap test compares). A partial run
 (``--effects``, ``--no-swaps``, ``--only-swaps``) updates the cases it ran in an existing
 hidden_effects.json and keeps the others, so one part can be re-measured alone.
 """

@@ -215,17 +215,6 @@ class CandidateFits:
         """Whether ``result`` was handed out again by ``run`` (a task done before), not done for that call."""
         return id(result) in self._recalled
 
-    def once(self, kind: str, model, args: tuple, compute):
-        """``compute()``, the result of task ``kind`` of ``model`` with ``args`` done in this process (a base fit), kept
-        as ``run`` keeps its tasks': the same task later (a slot alternative equal to an earlier round's model) is not
-        done again."""
-        key = task_key(kind, model, args)
-        if key is None:
-            return compute()
-        if key not in self._done:
-            self._done[key] = compute()
-        return self._done[key]
-
     def _run(self, kind: str, jobs: list[tuple]) -> Iterator[tuple[int, object]]:
         seeds = [task_seed(self._root, kind, model_key(job[0])) for job in jobs]
         parallel = self.workers > 1 and len(jobs) > 1 and not any(_from_a_file(job[0]) for job in jobs)

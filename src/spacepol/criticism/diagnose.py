@@ -17,7 +17,7 @@ from ..infer.optimum import find_optimum
 from ..infer.posterior import Posterior
 from ..physics.model import Model
 from ..physics.registry import registry
-from .candidate_fits import CandidateFits, fit_for_elpd, model_key
+from .candidate_fits import CandidateFits, model_key
 from .changes import BLIND_REASON, blind_changes, changes, separating_observables
 from .criteria import CRITERIA, CRITERION, MIN_DELTA_ELPD, Criterion, significant
 from .explain import (conclusion, posterior_quality, posterior_words, refitted_entry, signatures, tie_words,
@@ -139,8 +139,8 @@ def _fit_base(run: _Run, model: Model, base, candidates) -> list:
     run.blind = blind_changes(all_candidates, run.base_post.likelihood.objects)
     if base is None:
         run.say(f"[base] fitting {model.name} ({len(run.data)} geometries) ...")
-        args = (_vector(run.base_optimum, run.base_post), run.seed, run.max_steps, run.posterior_method)
-        base = run.fits.once("refit", model, args, lambda: fit_for_elpd(run.base_post, *args))
+        job = (model, run.base_post, _vector(run.base_optimum, run.base_post), run.seed, run.max_steps, run.posterior_method)
+        base = dict(run.fits.run("refit", [job], run.rng))[0]  # kept by ``fits`` as the candidates' refits are
     run.base = base
     run.clock["base"] = time.perf_counter()
     return [c for c in all_candidates if c not in run.blind]

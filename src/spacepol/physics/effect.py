@@ -158,7 +158,9 @@ class Effect:
     splits: dict = {}
     branches: tuple = ()
     intensity: str | None = None
-    hidden_values: tuple = ()  # values the hidden-effect suite hides in its renders (a small and a large one)
+    # values the hidden-effect suite hides in its renders (a small and a large one), each strictly inside its prior: a
+    # truth on a bound lies outside every central interval of a posterior that cannot cross the bound
+    hidden_values: tuple = ()
 
     def applicable(self, data) -> str | None:
         """None when the effect can be used with ``data``; else the reason, in words."""

@@ -78,15 +78,20 @@ class Case:
 
 
 def suite(effects=None, n_null: int = 8, seed: int = 0) -> list[Case]:
-    """Every effect x value x noise level, samplings and materials alternating; plus null sets."""
-    cases, k = [], 0
-    for effect in effects or HIDDEN_VALUES:
+    """Every effect x value x noise level, samplings and materials alternating; plus null sets. ``effects``: those
+    effects' cases only, each the same case (material, sampling, seed) as in the whole suite."""
+    unknown = sorted(set(effects or ()) - set(HIDDEN_VALUES))
+    if unknown:
+        raise ValueError(f"effects {', '.join(unknown)}: not among the suite's ({', '.join(HIDDEN_VALUES)})")
+    cases = []
+    for k, effect in enumerate(HIDDEN_VALUES):  # k: the effect's place in the whole suite, whatever is asked for
+        if effects and effect not in effects:
+            continue
         for v, hidden in enumerate(HIDDEN_VALUES[effect]):
             for j, (nd, nb) in enumerate(NOISE):
                 samp = ["in-plane-84", "two-sided-out-of-plane-72"][(v + j) % 2]
                 mat = list(MATERIALS)[(v + j + k) % 2]
                 cases.append(Case(f"{effect}#{v}/{nd}", effect, hidden, mat, nd, nb, samp, seed + 1000 * k + 10 * v + j))
-        k += 1
     for i in range(n_null):
         nd, nb = NOISE[i % 2]
         cases.append(Case(f"null#{i}", None, {}, list(MATERIALS)[(i // 2) % 2], nd, nb,

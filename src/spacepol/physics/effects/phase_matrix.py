@@ -36,7 +36,7 @@ class PhaseMatrix(SingleScattering):
     hidden_values = (  # a small and a large value, for the hidden-effect suite
         {"w_pm": 0.5, "g_pm": 0.3, "n_pm": 1.3, "pm_m22_0": 0.9, "pm_m22_60": 0.6, "pm_m12_60": -0.5, "pm_m22_120": 0.5,
          "pm_m12_120": -0.4},
-        {"w_pm": 1.0, "g_pm": -0.2, "n_pm": 1.25, "pm_m22_0": 0.8, "pm_m22_60": 0.4, "pm_m12_60": -0.8, "pm_m34_60": 0.3,
+        {"w_pm": 0.95, "g_pm": -0.2, "n_pm": 1.25, "pm_m22_0": 0.8, "pm_m22_60": 0.4, "pm_m12_60": -0.8, "pm_m34_60": 0.3,
          "pm_m22_120": 0.3, "pm_m12_120": -0.7, "pm_m22_180": 0.5},
     )
     requires = ()

@@ -11,7 +11,7 @@ class Volume(SingleScattering):
     """The ``volume`` effect: first-order volume scattering with the Code-Whitney phase matrix under the interface."""
     name = "volume"
     mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
-    hidden_values = ({"w_vol": 0.5, "g_vol": 0.3, "pl_vol": 0.8, "pc_vol": 0.0}, {"w_vol": 1.0, "g_vol": -0.2, "pl_vol": 1.0, "pc_vol": 0.3})  # a small and a large value, for the hidden-effect suite
+    hidden_values = ({"w_vol": 0.5, "g_vol": 0.3, "pl_vol": 0.8, "pc_vol": 0.0}, {"w_vol": 0.95, "g_vol": -0.2, "pl_vol": 0.9, "pc_vol": 0.3})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("w_vol", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the volume scatterers (scattering over "
                   "attenuation, the host's absorption included)", physical=(0.0, 1.0)),

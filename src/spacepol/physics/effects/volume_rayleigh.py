@@ -11,7 +11,7 @@ class VolumeRayleigh(SingleScattering):
     """The ``volume_rayleigh`` effect: first-order volume scattering with the Rayleigh phase matrix."""
     name = "volume_rayleigh"
     mirror_symmetric = True  # isotropic: M(-dphi) = D M(dphi) D
-    hidden_values = ({"w_ray": 0.5}, {"w_ray": 1.0})  # a small and a large value, for the hidden-effect suite
+    hidden_values = ({"w_ray": 0.5}, {"w_ray": 0.95})  # a small and a large value, for the hidden-effect suite
     parameters = (
         Parameter("w_ray", "", Uniform(0.0, 1.0), 0.5, "single-scattering albedo of the small (Rayleigh) scatterers",
                   physical=(0.0, 1.0)),

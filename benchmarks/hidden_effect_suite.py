@@ -88,10 +88,17 @@ def _table(rows) -> str:
              "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         size = "null" if r["effect"] == "none" else f"{r['size']:.2f}"
-        after = f"{r['chi2_red_after']:.2f} | {r['covered']}" if "chi2_red_after" in r else " | "
+        after = f"{r['chi2_red_after']:.2f} | {r['covered']}{_refit_words(r.get('refit'))}" if "chi2_red_after" in r else " | "
         lines.append(f"| {r['label']} | {r['material']} | {r['sampling']} | {size} | {r['verdict']} | "
                      f"{', '.join(r['tied_with'])} | {'yes' if r['correct'] else 'NO'} | {after} |")
     return "\n".join(lines) + "\n\n"
+
+
+def _refit_words(refit) -> str:
+    """Where the intervals came from a refit that did not converge, its R-hat."""
+    if not refit or refit.get("converged", True):
+        return ""
+    return f" (refit not converged: {refit['engine']}, R-hat {refit['rhat_max']:.2f})"
 
 
 def _swap_table(rows) -> str:

@@ -80,6 +80,18 @@ def test_a_part_of_the_suite_holds_the_same_cases_as_the_whole():
     with pytest.raises(ValueError, match="no_such_effect"):
         suite(["ggx", "no_such_effect"])
 
+def test_coverage_read_from_refits_that_did_not_converge_is_counted_apart():
+    """The summary's coverage counts every checked parameter, and says how many of them came from refits that did not
+    converge (emcee stopped for its ELPD-LOO), with their own coverage; a row without a refit record counts as
+    converged."""
+    row = {"effect": "ggx", "size": 10.0, "correct": True, "chi2_red_after": 1.0}
+    rows = [{**row, "covered": {"a": True, "b": False}, "refit": {"converged": False}},
+            {**row, "covered": {"c": True}, "refit": {"converged": True}}, {**row, "covered": {"d": True}}]
+    s = summarise(rows)
+    assert (s["n_parameters_checked"], s["coverage_90"]) == (4, 0.75)
+    assert (s["n_parameters_unconverged"], s["coverage_90_unconverged"]) == (2, 0.5)
+    assert summarise(rows[1:])["coverage_90_unconverged"] is None
+
 def _on_a_bound(effect: str, values: dict) -> list[str]:
     priors = {p.name: p.prior for p in registry.get(effect)().parameters}
     return [name for name, value in values.items() if not priors[name].lower < value < priors[name].upper]

@@ -24,6 +24,7 @@ from ..physics.geometry import Geometry, default_grid
 from ..physics.model import Model
 from ..physics.registry import BUILTIN_EFFECTS, registry
 from ..criticism.diagnose import diagnose
+from ..criticism.explain import posterior_quality
 
 BASE = "paper"
 MATERIALS = {  # two base materials the cases alternate between
@@ -157,6 +158,9 @@ def score(case: Case, report: dict) -> dict:
         inversion = confirmed[case.effect].inversion
         out["chi2_red_after"] = inversion.summary.fit["chi2_red"]
         out["covered"] = covered(case.effect, inversion, case.hidden)
+        # the intervals come from diagnose's refit: emcee stopped where its ELPD-LOO settled is no converged posterior
+        quality = posterior_quality(inversion)
+        out["refit"] = {k: quality.get(k) for k in ("engine", "converged", "rhat_max", "stopped_early")}
     return out
 
 
@@ -171,12 +175,13 @@ def run_case(case: Case, seed: int = 0, progress: bool = False) -> dict:
 
 def summarise(rows: list[dict], threshold: float = 3.0) -> dict:
     """The suite's figures: how often the hidden effect is named (all cases and those above ``threshold`` in size),
-    false alarms on null cases, interval coverage after the change."""
+    false alarms on null cases, interval coverage after the change (and that of the refits that did not converge)."""
     hidden = [r for r in rows if r["effect"] != "none"]
     big = [r for r in hidden if r["size"] >= threshold]
     nulls = [r for r in rows if r["effect"] == "none"]
     after = [r for r in big if "chi2_red_after" in r]
     covered = [ok for r in after for ok in r["covered"].values()]
+    unconverged = [ok for r in after if not r.get("refit", {}).get("converged", True) for ok in r["covered"].values()]
     return {
         "threshold_size": threshold,
         "n_hidden_big": len(big), "named_rate_big": float(np.mean([r["correct"] for r in big])) if big else None,
@@ -186,6 +191,9 @@ def summarise(rows: list[dict], threshold: float = 3.0) -> dict:
         "n_after": len(after),
         "chi2_within_1p5": float(np.mean([abs(r["chi2_red_after"] - 1) <= 1.5 for r in after])) if after else None,
         "n_parameters_checked": len(covered), "coverage_90": float(np.mean(covered)) if covered else None,
+        # of those, read from refits that did not converge (their misses are the sampler's as much as the model's)
+        "n_parameters_unconverged": len(unconverged),
+        "coverage_90_unconverged": float(np.mean(unconverged)) if unconverged else None,
     }
 
 

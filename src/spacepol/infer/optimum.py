@@ -148,9 +148,9 @@ def polish_posterior(posterior: Posterior, theta, ftol: float | None = None) -> 
 # multistart 0.4-0.7x as fast, its L-BFGS iterating longer; PTFE, 29,184 numbers, D 10: 1.3x faster; PTFE at four
 # wavelengths, every 8th row, 14,592 numbers, D 23, profiled: 3.7x faster with its compilation, the same maximum).
 # Speed is not all: on phase-matrix models (PTFE's in-plane rows, 1,728 numbers, D 28 and 37; the 84-point set, D 24)
-# the exact gradient was 1.7-8.8x faster but its L-BFGS-B stopped short at the realizability construction's kinks
-# (reached the best maximum in 2/3, 0/3, 0/3 seeds against finite differences' 3/3, 1/3, 3/3): those sets stay
-# below the rule's threshold
+# the exact gradient was 1.7-8.8x faster but its L-BFGS-B stopped short (reached the best maximum in 2/3, 0/3, 0/3
+# seeds against finite differences' 3/3, 1/3, 3/3; smoothing the realizability construction's abs and max changed
+# nothing: 0-1/3 on the 84-point set): those sets stay below the rule's threshold
 _GRADIENT_PAYS = 100_000
 
 

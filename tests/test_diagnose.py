@@ -272,7 +272,11 @@ if __name__ == "__main__":
         from spacepol.criticism.candidate_fits import CandidateFits  # here: the control's processes need no spacepol
 
         pool = CandidateFits(None, workers=2)._open()
-    else:  # the control: the same pool without diagnose's initializer
+    elif sys.argv[1] == "spawned":  # any pool of spacepol's (the validation suites', batch's)
+        from spacepol._runtime import spawned_pool
+
+        pool = spawned_pool(2)
+    else:  # the control: the same pool without spacepol's initializer
         pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn"))
     started = set()  # both workers have run their initializer once each has answered a task
     while len(started) < 2:
@@ -294,8 +298,8 @@ def _alive(pid: int) -> bool:
 @pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="reads /proc")
 def test_worker_processes_end_when_diagnose_is_killed(tmp_path):
     """A parent killed by SIGKILL (or a SIGTERM it does not handle) leaves a process pool's workers running; diagnose's
-    workers watch for it and end within seconds. Control: a plain pool's workers, busy for two minutes, are still
-    running 5 s after it."""
+    workers, and those of any pool ``spawned_pool`` starts, watch for it and end within seconds. Control: a plain
+    pool's workers, busy for two minutes, are still running 5 s after it."""
     import os
     import signal
     import subprocess
@@ -318,6 +322,7 @@ def test_worker_processes_end_when_diagnose_is_killed(tmp_path):
         return [p for p in workers if _alive(p)]
 
     assert orphans("fits", 15.0) == []  # the watchdog looks once a second
+    assert orphans("spawned", 15.0) == []
     left = orphans("plain", 5.0)
     try:
         assert left, "the control's workers ended with their parent: the test cannot see the difference"

@@ -153,11 +153,35 @@ def configure_jax() -> None:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
 
 
-def spawned_pool(workers: int, **options):
+def spawned_pool(workers: int, initializer=None, initargs: tuple = (), **options):
     """A ``ProcessPoolExecutor`` of ``workers`` processes started by spawn, never fork: a forked child of a process
     that has started JAX's thread pool can inherit a lock held by a thread it does not have and wait on it forever.
-    ``options``: the executor's other arguments."""
+    Its workers end when the process that started them is gone (``exit_with_parent``), then run ``initializer``
+    (with ``initargs``) where given. ``options``: the executor's other arguments."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"), **options)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_start_worker, initargs=(os.getpid(), initializer, initargs), **options)
+
+
+def _start_worker(parent: int, initializer, initargs: tuple) -> None:
+    exit_with_parent(parent)
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def exit_with_parent(parent: int, every_s: float = 1.0) -> None:
+    """This process ends when the one that started it (``parent``, its pid as the parent saw it: a parent killed
+    while this process was still starting is gone already when it looks) is gone: a pool's workers outlive a parent
+    killed by a signal it cannot handle (SIGTERM, SIGKILL), and went on fitting for minutes with nobody to read
+    them."""
+    import threading
+    import time
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(every_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="spacepol-parent-watch", daemon=True).start()

@@ -6,8 +6,6 @@ The reasoning behind it, and what was measured: the internals page of the docume
 
 from __future__ import annotations
 
-import os
-import time
 import zlib
 from concurrent.futures import as_completed
 from typing import Iterator
@@ -132,28 +130,12 @@ _WORKER_KEEPS = 4  # posteriors a worker keeps
 _WORKER: dict = {}  # in a worker process: the data and the fitting settings, sent once
 
 
-def _start_worker(data, observables, priors, small_calls: bool | None, parent: int) -> None:
-    _exit_with_parent(parent)
+def _start_worker(data, observables, priors, small_calls: bool | None) -> None:
     if small_calls is not None:  # the settings the calling process chose (None: it chose none)
         from .._runtime import configure_process
 
         configure_process(small_calls=small_calls)
     _WORKER.update(data=data, observables=observables, priors=priors)
-
-
-def _exit_with_parent(parent: int, every_s: float = 1.0) -> None:
-    """A worker ends when the process that started it (``parent``, its pid as the parent saw it: a parent killed
-    while the worker was still starting is gone already when it looks) is gone: a pool's workers outlive a parent
-    killed by a signal it cannot handle (SIGTERM, SIGKILL), and went on refitting candidates for minutes with nobody
-    to read them."""
-    import threading
-
-    def watch():
-        while os.getppid() == parent:
-            time.sleep(every_s)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="spacepol-parent-watch", daemon=True).start()
 
 
 def _in_worker(kind: str, model, args: tuple):
@@ -241,7 +223,7 @@ class CandidateFits:
             from .._runtime import configured, spawned_pool
 
             self._pool = spawned_pool(self.workers, initializer=_start_worker,
-                                      initargs=(self.data, self.observables, self.priors, configured(), os.getpid()))
+                                      initargs=(self.data, self.observables, self.priors, configured()))
         return self._pool
 
     def close(self) -> None:

@@ -69,7 +69,6 @@ def test_effect_size_is_what_the_base_model_cannot_absorb():
     assert s2 == pytest.approx(2 * s1, rel=0.05)
 
 
-
 def test_a_part_of_the_suite_holds_the_same_cases_as_the_whole():
     """``--effects`` re-measures cases of the whole suite (their material, sampling and seed), so that its rows may
     replace the whole run's; an effect the suite does not have is named."""
@@ -79,6 +78,7 @@ def test_a_part_of_the_suite_holds_the_same_cases_as_the_whole():
     assert all(c == whole[c.label] for c in part)
     with pytest.raises(ValueError, match="no_such_effect"):
         suite(["ggx", "no_such_effect"])
+
 
 def test_coverage_read_from_refits_that_did_not_converge_is_counted_apart():
     """The summary's coverage counts every checked parameter, and says how many of them came from refits that did not
@@ -92,6 +92,7 @@ def test_coverage_read_from_refits_that_did_not_converge_is_counted_apart():
     assert (s["n_parameters_unconverged"], s["coverage_90_unconverged"]) == (2, 0.5)
     assert summarise(rows[1:])["coverage_90_unconverged"] is None
 
+
 def _on_a_bound(effect: str, values: dict) -> list[str]:
     priors = {p.name: p.prior for p in registry.get(effect)().parameters}
     return [name for name, value in values.items() if not priors[name].lower < value < priors[name].upper]
@@ -102,6 +103,7 @@ def test_every_hidden_value_lies_inside_its_prior():
     bound, so the coverage check would count a miss whatever the fit: the suite hides none there."""
     assert all(_on_a_bound(effect, v) == [] for effect, values in HIDDEN_VALUES.items() for v in values)
     assert _on_a_bound("volume", {"w_vol": 1.0, "g_vol": 0.2}) == ["w_vol"]  # control: the check sees a bound
+
 
 @pytest.mark.slow
 def test_hidden_effect_suite_meets_the_acceptance_rates():

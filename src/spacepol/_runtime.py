@@ -174,8 +174,7 @@ def _start_worker(parent: int, initializer, initargs: tuple) -> None:
 def exit_with_parent(parent: int, every_s: float = 1.0) -> None:
     """This process ends when the one that started it (``parent``, its pid as the parent saw it: a parent killed
     while this process was still starting is gone already when it looks) is gone: a pool's workers outlive a parent
-    killed by a signal it cannot handle (SIGTERM, SIGKILL), and went on fitting for minutes with nobody to read
-    them."""
+    killed by a signal it cannot handle (SIGTERM, SIGKILL) and would go on computing with nobody to read them."""
     import threading
     import time
 

@@ -28,6 +28,7 @@ from spacepol._runtime import spawned_pool
 from spacepol.validation.hidden_effects import run_suite, suite, summarise
 from spacepol.validation.swap_suite import run_swap_case, summarise_swaps, swap_suite
 from spacepol.validation.verdicts import verdicts
+from spacepol.criticism.explain import unconverged_words
 from spacepol.io.atomic import save_figure, write_json
 from spacepol.report.criticism_figures import validation_figure
 
@@ -95,10 +96,10 @@ def _table(rows) -> str:
 
 
 def _refit_words(refit) -> str:
-    """Where the intervals came from a refit that did not converge, its R-hat."""
+    """Where the intervals came from a refit that did not converge, how far it got (``explain.unconverged_words``)."""
     if not refit or refit.get("converged", True):
         return ""
-    return f" (refit not converged: {refit['engine']}, R-hat {refit['rhat_max']:.2f})"
+    return f" (the refit {unconverged_words(refit)})"
 
 
 def _swap_table(rows) -> str:

@@ -159,8 +159,7 @@ def score(case: Case, report: dict) -> dict:
         out["chi2_red_after"] = inversion.summary.fit["chi2_red"]
         out["covered"] = covered(case.effect, inversion, case.hidden)
         # the intervals come from diagnose's refit: emcee stopped where its ELPD-LOO settled is no converged posterior
-        quality = posterior_quality(inversion)
-        out["refit"] = {k: quality.get(k) for k in ("engine", "converged", "rhat_max", "stopped_early")}
+        out["refit"] = {k: v for k, v in posterior_quality(inversion).items() if k != "laplace_refused"}
     return out
 
 

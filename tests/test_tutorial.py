@@ -4,6 +4,7 @@ Result.load -> contrast) on a two-wavelength set uses that run's n and k at the 
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -18,10 +19,15 @@ def _blocks() -> list[str]:
 
 @pytest.fixture(scope="module")
 def tutorial():
+    """The tutorial's namespace after running it; its working folder (a temporary folder it makes) removed after."""
     namespace: dict = {"__name__": "tutorial"}
-    for block in _blocks():
-        exec(compile(block, str(TUTORIAL), "exec"), namespace)
-    return namespace
+    try:
+        for block in _blocks():
+            exec(compile(block, str(TUTORIAL), "exec"), namespace)
+        yield namespace
+    finally:
+        if "work" in namespace:
+            shutil.rmtree(namespace["work"], ignore_errors=True)
 
 
 def test_the_tutorial_uses_only_the_top_level_api():

@@ -35,7 +35,7 @@ DRAWS_FOR_LOO = 2000
 # (and the next seed of the material's stream), at most this many times: on a calibration render of smooth solar glass
 # (nearly all of its light in glints) 100 live points stalled from two seeds, where 200 finished
 STALL_RESTARTS = 2
-BLOCK = 16  # sets per model evaluation (its cost grows as the square of the sets)
+BLOCK = 256  # sets per model evaluation (each set at its own geometry rows)
 
 
 def predicted(model: LightCurveModel, theta: np.ndarray) -> dict[str, np.ndarray]:

@@ -5,8 +5,8 @@ The faces turn with the attitude (``orbit.attitude``), each face's angles follow
 material's model gives each lit and seen face's Stokes vector, and the faces' light adds up in the observer's sky
 basis as ``target.target_light`` adds it (the same scale E cos(theta_i) A cos(theta_r) / R^2 and rotation).
 
-Each evaluation takes S sets at once: the material's model is evaluated for the S sets at all S sets' geometries
-and the S diagonal blocks kept (S^2 T F evaluations; at S = 32, T = 30 times and F = 4 faces, 123,000).
+Each evaluation takes S sets at once: the material's model is evaluated for the S sets, each at its own geometry (one
+geometry row per set: S T F evaluations).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..orbit.attitude import ANGLES, Attitude, rotations
 from ..orbit.pass_geometry import face_angles, orbit_axes
+from ..physics.compiled import bucket
 from ..physics.geometry import Geometry
 from ..priors import Prior, Uniform
 from .materials import Material
@@ -111,21 +112,31 @@ class LightCurveModel:
 
     def _brdf(self, theta: np.ndarray, angles: tuple, n_sets: int) -> np.ndarray:
         """(3, F * S * T) each face's Stokes BRDF at its rows' ``angles`` (theta_i, theta_r, dphi in degrees): the
-        unknown material's faces at each set's own parameters (one evaluation of the S sets at all their rows, its
-        diagonal blocks kept), each fixed material's faces in one evaluation of its own."""
+        unknown material's faces at each set's own parameters and its own geometry (a (S, F_u * T) geometry, one
+        row per set: S F_u T evaluations), each fixed material's faces in one evaluation of its own."""
         g = self.geometry
         per_face = len(angles[0]) // len(g.faces)
         out = np.zeros((3, len(angles[0])))
         material = self._held | {n: theta[:, j] for j, n in enumerate(self.names) if n not in ANGLES}
         for key, faces in by_material(g.faces, np.arange(len(g.faces))).items():
             index = np.concatenate([np.arange(k * per_face, (k + 1) * per_face) for k in faces])
-            sub = Geometry(*(a[index] for a in angles))
             if key is not None:
                 model, values = fixed_material(dict(key))
+                sub = Geometry(*(a[index] for a in angles))
                 out[:, index] = np.asarray(model.evaluate(values, sub, check=False).stokes, float)[:3]
                 continue
-            full = np.asarray(self.model.evaluate(material, sub, check=False).stokes, float)[:3]  # (3, S, F_u * S * T)
-            blocks = full.reshape(3, n_sets, len(faces), n_sets, -1)
-            diagonal = blocks[:, np.arange(n_sets), :, np.arange(n_sets), :]  # (S, 3, F_u, T)
-            out[:, index] = diagonal.transpose(1, 2, 0, 3).reshape(3, -1)
+            out[:, index] = self._paired(material, [a[index] for a in angles], len(faces), n_sets)
         return out
+
+    def _paired(self, material: dict, angles: list, n_faces: int, n_sets: int) -> np.ndarray:
+        """(3, F_u * S * T) the unknown material at each set's parameters and that set's rows of ``angles`` (face-major,
+        then set, then time): the rows laid out as one geometry row per set, padded to the compiled program's number of
+        sets by repeating the last set's rows."""
+        per_set = [np.asarray(a, float).reshape(n_faces, n_sets, -1).transpose(1, 0, 2).reshape(n_sets, -1)
+                   for a in angles]
+        rows = bucket(n_sets)
+        if rows > n_sets:
+            per_set = [np.pad(a, ((0, rows - n_sets), (0, 0)), mode="edge") for a in per_set]
+        stokes = np.asarray(self.model.evaluate(material, Geometry(*per_set), check=False).stokes, float)[:3]
+        stokes = stokes[:, :n_sets]  # (3, S, F_u * T): the padded sets' rows off
+        return stokes.reshape(3, n_sets, n_faces, -1).transpose(0, 2, 1, 3).reshape(3, -1)

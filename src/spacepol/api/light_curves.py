@@ -174,8 +174,9 @@ def _assumptions(element_set, site, curve, start, end, faces, attitude, band_um,
         ("Attitude: offsets known from the target file: " + ", ".join(f"{k} {v:g}" for k, v in attitude.to_json().items())
          if attitude is not None else f"Attitude: yaw, pitch and roll offsets inferred, each uniform within "
          f"{ATTITUDE_LIMIT_DEG:g} deg of the nominal orientation (z-y-x about the orbit frame)."),
-        f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um; fitted: {', '.join(observables)}, each "
-        "Gaussian with the file's errors (AoP on its 180-deg circle).",
+        f"Sun: a 5772 K black body at 1 au in {band_um[0]:g}-{band_um[1]:g} um; fitted: {', '.join(observables)} with the "
+        "file's errors (the flux Gaussian; DoLP and AoP as measured from Stokes q and u with Gaussian errors, unbiased "
+        "where the polarization is near its noise).",
         f"Posterior and evidence: nested sampling (nautilus, {live} live points) from the whole prior, every mode it "
         "finds weighted by its mass; ELPD-LOO by PSIS over the measured points.",
     ]

@@ -2,8 +2,9 @@
 material's parameters and the attitude offsets and its evidence (nested sampling, nautilus), ranked by ELPD-LOO
 (PSIS over the light curve's points).
 
-The likelihood: each measured point (flux, DoLP, AoP at a time) is Gaussian about the model's value with the
-file's 1-sigma error; an AoP residual is taken on its 180-deg circle. The posterior is narrow and its optima many (a
+The likelihood: the flux Gaussian about the model's value with the file's 1-sigma error; DoLP and AoP as measured
+from normalized Stokes q, u with Gaussian errors (``light_curve_likelihood``: unbiased where the polarization is near
+its noise). The posterior is narrow and its optima many (a
 box's faces alike under a turn; a narrow glint of smooth facets against a broad one of rough facets): nested
 sampling shrinks from the whole prior, so it finds the modes a local sampler started at one optimum would miss.
 """
@@ -20,8 +21,8 @@ import numpy as np
 
 from ..errors import ParameterError, SamplerStalled
 from ..infer.diagnostics import loo
-from ..io.light_curve import OBSERVABLES
 from ..orbit.attitude import ANGLES
+from .light_curve_likelihood import pointwise, replicates
 from .light_curve_model import LightCurveModel
 from .target import linear_polarization
 
@@ -45,22 +46,10 @@ def predicted(model: LightCurveModel, theta: np.ndarray) -> dict[str, np.ndarray
     return {"flux": s0, "dolp": dolp, "aop_deg": aop}
 
 
-def _wrapped_aop(difference):
-    """An AoP difference (deg) on its 180-deg circle, in [-90, 90)."""
-    return (difference + 90.0) % 180.0 - 90.0
-
-
 def pointwise_log_likelihood(model: LightCurveModel, curve, observables: list[str], theta: np.ndarray) -> np.ndarray:
-    """(S, M) the log-likelihood of each measured number (observables in order, then times) at rows ``theta``."""
-    mu = predicted(model, theta)
-    parts = []
-    for name in observables:
-        measured, error = getattr(curve, name), getattr(curve, OBSERVABLES[name])
-        residual = measured - np.nan_to_num(mu[name])  # no light predicted: a model of 0 flux, DoLP and AoP
-        if name == "aop_deg":
-            residual = _wrapped_aop(residual)
-        parts.append(-0.5 * (residual / error) ** 2 - np.log(error * np.sqrt(2 * np.pi)))
-    return np.concatenate(parts, axis=1)
+    """(S, M) the log-likelihood of each measured number (observables in order, then times) at rows ``theta``
+    (``light_curve_likelihood.pointwise``)."""
+    return pointwise(curve, observables, predicted(model, theta))
 
 
 @dataclass
@@ -195,15 +184,8 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:
     """{observable: (3, T)} the 5/50/95 % of the posterior predictive (the model plus the file's noise)."""
-    out = {}
-    for name, values in predicted(model, draws).items():
-        error = getattr(curve, OBSERVABLES[name])
-        noise = 0.0 if error is None else error * rng.standard_normal(values.shape)
-        replicated = np.nan_to_num(values) + noise
-        if name == "aop_deg":
-            replicated = _wrapped_aop(replicated)
-        out[name] = np.percentile(replicated, [5, 50, 95], axis=0)
-    return out
+    return {name: np.percentile(values, [5, 50, 95], axis=0)
+            for name, values in replicates(curve, predicted(model, draws), rng).items()}
 
 
 def _points_carrying_half(difference: np.ndarray) -> int:

@@ -124,12 +124,12 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     assert "Few effective draws" not in report and "restart" not in report and "second attitude" not in report
     rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "kapton" else f for f in inversion.fits])
     assert "Few effective draws (under 200) for kapton (3)" in verdict_text(rough.to_json())
-    # a restarted exploration and an attitude the draws miss are named too, and survive a save and a load
-    missed = {"attitude": {"yaw_deg": -40.0, "pitch_deg": 5.0, "roll_deg": 2.0}, "log_posterior": -10.0,
-              "below_best": -1.5, "finding": "a second attitude (yaw -40.0, pitch 5.0, roll 2.0 deg) fits better"}
-    replace(best, restarts=1, unsampled_attitude=missed).save(folder / "marked.npz", "key")
+    # a restarted exploration and an attitude sampled in a second run are named too, and survive a save and a load
+    added = {"attitude": {"yaw_deg": -40.0, "pitch_deg": 5.0, "roll_deg": 2.0}, "share": 0.4, "log_posterior": -10.0,
+             "finding": "a second attitude (yaw -40.0, pitch 5.0, roll 2.0 deg) the exploration missed was sampled"}
+    replace(best, restarts=1, added_attitude=added).save(folder / "marked.npz", "key")
     loaded = MaterialFit.load(folder / "marked.npz", "key")
-    assert loaded.restarts == 1 and loaded.unsampled_attitude == missed
+    assert loaded.restarts == 1 and loaded.added_attitude == added
     text = verdict_text(replace(inversion, fits=[loaded if f is best else f for f in inversion.fits]).to_json())
     assert "solar_glass (1 restart)" in text and "For solar_glass, a second attitude (yaw -40.0" in text, text
 
@@ -165,3 +165,37 @@ def test_every_library_material_has_priors_for_every_parameter_of_its_model():
         m = material(name, 1.65)
         params = {p.name for p in spacepol.Model.from_string(m.model).parameters}
         assert set(m.priors) == params, name
+
+
+def test_a_missed_attitude_mode_is_joined_by_its_mass_under_the_whole_prior():
+    """Two narrow attitude modes of masses 0.3 and 0.7 (uniform prior within 60 deg): a first run that holds the first
+    and a sliver of the second (its mass underestimated), and a second run within the box about the second. The
+    joined evidence is the two masses' sum to 1e-9 and the second mode's share 0.7; the first run's points inside the
+    box are dropped (control: keeping them counts the second mode twice)."""
+    from types import SimpleNamespace
+
+    from spacepol.detect.attitude_modes import AttitudeMode
+    from spacepol.detect.light_curve_inversion import _joined, _mode_box, _Run
+    from spacepol.priors import Uniform
+
+    model = SimpleNamespace(names=["yaw_deg", "pitch_deg", "roll_deg"], priors=[Uniform(-60.0, 60.0)] * 3)
+    rng = np.random.default_rng(0)
+    volume = 120.0**3
+    a, b = np.array([20.0, 0.0, 0.0]), np.array([-20.0, 5.0, 0.0])
+    mass_a, mass_b = 0.3 / volume, 0.7 / volume  # each mode's evidence under the whole prior
+    first_points = np.vstack([a + rng.normal(0, 1, (900, 3)), b + rng.normal(0, 1, (100, 3))])
+    first_mass = np.r_[np.full(900, np.log(mass_a / 900)), np.full(100, np.log(0.01 * mass_b / 100))]
+    first = _Run(first_points, first_mass, float(np.log(mass_a + 0.01 * mass_b)), 1000, 0)
+    mode = AttitudeMode(dict(zip(model.names, b)), b, -1.0, 0.5, "found")
+    box = _mode_box(model, mode.attitude)
+    assert np.allclose(box, [[-35, -5], [-10, 20], [-15, 15]])
+    box_volume = np.prod(box[:, 1] - box[:, 0])
+    second_z = mass_b * volume / box_volume  # the same mode's evidence under the prior restricted to the box
+    second = _Run(b + rng.normal(0, 1, (500, 3)), np.full(500, np.log(second_z / 500)), float(np.log(second_z)), 500, 0)
+    joined, added = _joined(model, first, second, box, mode)
+    assert abs(joined.log_z - np.log(mass_a + mass_b)) < 1e-9
+    assert abs(added["share"] - 0.7) < 1e-9 and "70 %" in added["finding"]
+    assert len(joined.points) == 1400 and joined.calls == 1500
+    # control: the first run's points in the box kept as well
+    doubled = np.logaddexp(joined.log_z, np.log(0.01 * mass_b))
+    assert doubled - np.log(mass_a + mass_b) > 1e-3

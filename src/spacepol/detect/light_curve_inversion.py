@@ -57,8 +57,9 @@ class MaterialFit:
     """One candidate's posterior: ``names``, ``samples`` (equally weighted draws, D), the ELPD-LOO record (``loo``:
     elpd_loo, elpd_loo_se, p_loo, pareto_k, pointwise), nested sampling's ``log_evidence`` (ln Z), its weighted
     points' ``effective_draws`` and its ``likelihood_calls``, the posterior-predictive bands {observable: (3, T)
-    5/50/95 %}, ``seconds``, the ``restarts`` a stalled exploration took (``STALL_RESTARTS``), and an attitude mode
-    the draws miss (``attitude_modes.unsampled_mode``: its record, or None)."""
+    5/50/95 %}, ``seconds``, the ``restarts`` a stalled exploration took (``STALL_RESTARTS``), and the attitude mode
+    the exploration missed and a second run sampled (``fit_material``: its attitude, share of the posterior and a
+    finding in words; None where there was none)."""
 
     material: str
     description: str
@@ -71,7 +72,7 @@ class MaterialFit:
     bands: dict
     seconds: float
     restarts: int = 0
-    unsampled_attitude: dict | None = None
+    added_attitude: dict | None = None
 
     def save(self, path, key: str) -> None:
         """This fit in one .npz file (written whole or not at all), labelled with ``key`` (what it was fitted to)."""
@@ -80,7 +81,7 @@ class MaterialFit:
         scalars = {"material": self.material, "description": self.description, "names": self.names, "key": key,
                    "log_evidence": self.log_evidence, "effective_draws": self.effective_draws,
                    "likelihood_calls": self.likelihood_calls,
-                   "seconds": self.seconds, "restarts": self.restarts, "unsampled_attitude": self.unsampled_attitude,
+                   "seconds": self.seconds, "restarts": self.restarts, "added_attitude": self.added_attitude,
                    "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
         arrays = {"samples": self.samples, "pointwise": self.loo["pointwise"], "pareto_k": self.loo["pareto_k"]}
         arrays |= {f"band_{k}": v for k, v in self.bands.items()}
@@ -101,7 +102,7 @@ class MaterialFit:
                 record = scalars["loo"] | {"pointwise": f["pointwise"], "pareto_k": f["pareto_k"]}
                 return cls(scalars["material"], scalars["description"], scalars["names"], f["samples"], record,
                            scalars["log_evidence"], scalars["effective_draws"], scalars["likelihood_calls"], bands, scalars["seconds"],
-                           scalars.get("restarts", 0), scalars.get("unsampled_attitude"))
+                           scalars.get("restarts", 0), scalars.get("added_attitude"))
         except (OSError, ValueError, KeyError, EOFError):
             return None
 
@@ -114,15 +115,16 @@ class MaterialFit:
 def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.random.Generator, live: int = 500,
                  progress: bool = False) -> MaterialFit:
     """``model``'s posterior given ``curve``'s ``observables`` and its evidence ln Z: nested sampling (nautilus,
-    ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode."""
-    from nautilus import Sampler
-
-    from ..infer.engines.nested import explore_then_sample, kish_draws, replicate_draws
+    ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode it resolves.
+    Where the draws miss the mirrored attitude's mode (``attitude_modes``), a second run samples the angles within
+    ``BOX_DEG`` of it, and the two are joined over that partition of the prior (``_joined``)."""
+    from ..infer.engines.nested import kish_draws
     from ..infer.engines.stall_guard import CallClock
 
     start = time.perf_counter()
     calls = {"sets": 0, "next": 20000}
     clock = CallClock()
+    name = model.material.name
 
     def log_likelihood(theta):
         clock.tick()
@@ -131,44 +133,127 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
         calls["sets"] += len(theta)
         if progress and calls["sets"] >= calls["next"]:
             calls["next"] += 20000
-            print(f"  {model.material.name}: {calls['sets']} likelihood evaluations, {time.perf_counter() - start:.0f} s",
+            print(f"  {name}: {calls['sets']} likelihood evaluations, {time.perf_counter() - start:.0f} s",
                   file=sys.stderr)
         return np.where(np.isfinite(out), out, -1e300)  # nautilus needs finite numbers
 
+    run = _nested(model, log_likelihood, _rescaling(model), live, rng, clock, f"material {name}")
+    kept = _equal_draws(run, rng)
+    missed, added = _unsampled_attitude(model, curve, observables, kept, rng), None
+    if missed is not None:
+        if progress:
+            print(f"  {name}: {missed.finding}; sampling that attitude on its own", file=sys.stderr)
+        box = _mode_box(model, missed.attitude)
+        second = _nested(model, log_likelihood, _rescaling(model, box), live, rng, clock,
+                         f"material {name}, its second attitude")
+        run, added = _joined(model, run, second, box, missed)
+        kept = _equal_draws(run, rng)
+    ll = pointwise_log_likelihood(model, curve, observables, kept)
+    labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
+    record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
+                              log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
+    return MaterialFit(name, model.material.description, list(model.names), kept, record, run.log_z,
+                       kish_draws(run.log_mass), run.calls, _bands(model, curve, kept[:200], rng),
+                       time.perf_counter() - start, run.restarts, added)
+
+
+@dataclass
+class _Run:
+    """Weighted points of nested sampling: ``log_mass`` each point's ln share of the evidence (its normalised weight
+    times Z), ``log_z`` their ln sum, the likelihood ``calls`` and the ``restarts`` of stalled explorations."""
+
+    points: np.ndarray
+    log_mass: np.ndarray
+    log_z: float
+    calls: int
+    restarts: int
+
+
+def _rescaling(model: LightCurveModel, box: np.ndarray | None = None):
+    """The map from nautilus's unit cube to the prior; with ``box`` ((3, 2) deg), the attitude angles uniform within
+    it instead (the prior restricted to the box: the angles' priors are uniform)."""
+    angles = [model.names.index(a) for a in ANGLES] if box is not None else []
+
     def rescale(u):
-        return np.column_stack([p.rescale(u[:, j]) for j, p in enumerate(model.priors)])
+        columns = [p.rescale(u[:, j]) for j, p in enumerate(model.priors)]
+        for k, j in enumerate(angles):
+            columns[j] = box[k, 0] + u[:, j] * (box[k, 1] - box[k, 0])
+        return np.column_stack(columns)
+
+    return rescale
+
+
+def _nested(model: LightCurveModel, log_likelihood, rescale, live: int, rng: np.random.Generator, clock,
+            what: str) -> _Run:
+    """One nested-sampling run to its draws; a stalled exploration starts again from the prior with twice the live
+    points (``STALL_RESTARTS``)."""
+    from nautilus import Sampler
+    from scipy.special import logsumexp
+
+    from ..infer.engines.nested import explore_then_sample
 
     for restarts in range(STALL_RESTARTS + 1):
         sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live * 2**restarts, n_networks=1,
                           vectorized=True, seed=int(rng.integers(2**31)))
         try:
-            explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, f"material {model.material.name}")
+            explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, what)
             break
         except SamplerStalled as stalled:
             if restarts == STALL_RESTARTS:
                 raise SamplerStalled(f"{stalled} (it stalled {restarts + 1} times, with up to {live * 2**restarts} live "
                                      "points)") from None
-            print(f"  {model.material.name}: {stalled}; starting again from the prior with {2 * live * 2**restarts} live "
-                  "points", file=sys.stderr)
+            print(f"  {what}: {stalled}; starting again from the prior with {2 * live * 2**restarts} live points",
+                  file=sys.stderr)
     points, log_w, _ = sampler.posterior()
-    effective = kish_draws(log_w)
-    kept = points[replicate_draws(points, log_w, rng, min(DRAWS_FOR_LOO, len(points)))]
+    log_z = float(sampler.log_z)
+    return _Run(points, log_w - logsumexp(log_w) + log_z, log_z, int(sampler.n_like), restarts)
+
+
+def _equal_draws(run: _Run, rng: np.random.Generator) -> np.ndarray:
+    """Equally weighted draws of a run's points, shuffled."""
+    from ..infer.engines.nested import replicate_draws
+
+    kept = run.points[replicate_draws(run.points, run.log_mass, rng, min(DRAWS_FOR_LOO, len(run.points)))]
     rng.shuffle(kept)
-    ll = pointwise_log_likelihood(model, curve, observables, kept)
-    labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
-    record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
-                              log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
-    missed = _unsampled_attitude(model, curve, observables, kept, ll.sum(axis=1) + model.log_prior(kept), rng)
-    if progress and missed is not None:
-        print(f"  {model.material.name}: {missed['finding']}", file=sys.stderr)
-    return MaterialFit(model.material.name, model.material.description, list(model.names), kept, record,
-                       float(sampler.log_z), effective, int(sampler.n_like), _bands(model, curve, kept[:200], rng),
-                       time.perf_counter() - start, restarts, missed)
+    return kept
+
+
+def _mode_box(model: LightCurveModel, attitude: dict) -> np.ndarray:
+    """(3, 2) the angles within ``attitude_modes.BOX_DEG`` of ``attitude``, inside the prior."""
+    from .attitude_modes import BOX_DEG
+
+    bounds = [model.priors[model.names.index(a)].bounds for a in ANGLES]
+    return np.array([[max(lo, attitude[a] - BOX_DEG), min(hi, attitude[a] + BOX_DEG)] for a, (lo, hi) in zip(ANGLES, bounds)])
+
+
+def _joined(model: LightCurveModel, first: _Run, second: _Run, box: np.ndarray, mode) -> tuple[_Run, dict]:
+    """The posterior over the prior split into the box about a missed mode and the rest: ``first``'s points outside
+    the box (its estimate of the rest's mass) and ``second``'s, sampled within it, each weighted by its mass under the
+    whole prior (the box's prior probability times its own evidence). Returns the joined run and a record of the mode
+    added: its attitude, its share of the posterior, a finding in words."""
+    from scipy.special import logsumexp
+
+    columns = [model.names.index(a) for a in ANGLES]
+    bounds = np.array([model.priors[j].bounds for j in columns], float)
+    inside = np.all((first.points[:, columns] >= box[:, 0]) & (first.points[:, columns] <= box[:, 1]), axis=1)
+    box_prior = float(np.sum(np.log((box[:, 1] - box[:, 0]) / (bounds[:, 1] - bounds[:, 0]))))
+    second_mass = second.log_mass + box_prior
+    log_mass = np.concatenate([first.log_mass[~inside], second_mass])
+    log_z = float(logsumexp(log_mass))
+    share = float(np.exp(logsumexp(second_mass) - log_z))
+    at = ", ".join(f"{a.removesuffix('_deg')} {v:.1f}" for a, v in mode.attitude.items())
+    added = {"attitude": mode.attitude, "share": share, "log_posterior": mode.log_posterior,
+             "finding": f"a second attitude ({at} deg) the exploration missed was sampled on its own and holds "
+                        f"{100 * share:.0f} % of the posterior"}
+    joined = _Run(np.concatenate([first.points[~inside], second.points]), log_mass, log_z,
+                  first.calls + second.calls, first.restarts + second.restarts)
+    return joined, added
 
 
 def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], draws: np.ndarray,
-                        draws_log_posterior: np.ndarray, rng: np.random.Generator) -> dict | None:
-    """``attitude_modes.unsampled_mode`` of a fit's draws (None where the attitude is known)."""
+                        rng: np.random.Generator):
+    """``attitude_modes.unsampled_mode`` of a fit's draws (an ``AttitudeMode``; None where the draws miss none or the
+    attitude is known)."""
     from .attitude_modes import unsampled_mode
 
     if model.attitude is not None:
@@ -177,9 +262,8 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
     def log_posterior(theta):
         return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
 
-    mode = unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws, draws_log_posterior,
-                          rng)
-    return None if mode is None else mode.to_json()
+    return unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws,
+                          log_posterior(draws), rng)
 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:
@@ -263,6 +347,6 @@ class LightCurveInversion:
                                             "likelihood_calls": f.likelihood_calls,
                                             "p_loo": f.loo["p_loo"], "pareto_k_max": float(np.max(f.loo["pareto_k"])),
                                             "seconds": f.seconds, "restarts": f.restarts,
-                                            "unsampled_attitude": f.unsampled_attitude} for f in self.fits},
+                                            "added_attitude": f.added_attitude} for f in self.fits},
                 "times_utc": [t.strftime("%Y-%m-%dT%H:%M:%SZ") for t in self.curve.times_utc],
                 "assumptions": self.assumptions}

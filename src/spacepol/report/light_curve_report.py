@@ -61,7 +61,7 @@ LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider tha
 
 def verdict_text(content: dict) -> str:
     """The report's verdict in words from lightcurve.json's ``content``: the material the curve reads as and by how
-    much, and every caution the fits carry (few effective draws, restarted explorations, an attitude the draws miss,
+    much, and every caution the fits carry (few effective draws, restarted explorations, an attitude sampled in a second run,
     offsets the curve does not determine)."""
     second = content["ranking"][1] if len(content["ranking"]) > 1 else None
     verdict = f"The light curve reads as {content['best']}"
@@ -84,9 +84,9 @@ def verdict_text(content: dict) -> str:
     if restarted:
         verdict += (f" Nested sampling's exploration stalled and started again from the prior with twice the live "
                     f"points for {', '.join(restarted)} (its neural bound rejected nearly every point drawn).")
-    missed = content["candidates"][content["best"]].get("unsampled_attitude")
-    if missed:
-        verdict += f" For {content['best']}, {missed['finding']}."
+    added = content["candidates"][content["best"]].get("added_attitude")
+    if added:
+        verdict += f" For {content['best']}, {added['finding']}."
     loose = [k for k, v in content["attitude"].items() if v["q95"] - v["q05"] > LOOSE_ATTITUDE_DEG]
     if loose:
         verdict += (f" Not determined by this light curve (90 % interval wider than {LOOSE_ATTITUDE_DEG:g} deg: several "

@@ -142,14 +142,16 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     missed, added = _unsampled_attitude(model, curve, observables, kept, rng), None
     if missed is not None:
         if progress:
-            print(f"  {name}: {missed.finding}; sampling that attitude on its own", file=sys.stderr)
+            at = ", ".join(f"{a.removesuffix('_deg')} {v:.1f}" for a, v in missed.attitude.items())
+            print(f"  {name}: a second attitude ({at} deg) outside every draw fits about as well; sampling it on its own",
+                  file=sys.stderr)
         box = _mode_box(model, missed.attitude)
         second = _nested(model, log_likelihood, _rescaling(model, box), live, rng, clock,
                          f"material {name}, its second attitude")
         run, added = _joined(model, run, second, box, missed)
         kept = _equal_draws(run, rng)
     ll = pointwise_log_likelihood(model, curve, observables, kept)
-    labels = [f"{name}[{t:%H:%M:%S}]" for name in observables for t in curve.times_utc]
+    labels = [f"{observable}[{t:%H:%M:%S}]" for observable in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
     return MaterialFit(name, model.material.description, list(model.names), kept, record, run.log_z,

@@ -95,7 +95,8 @@ def run_case(case: dict, folder: Path, live: int, seed: int) -> dict:
     for label, observables in (("polarization", None), ("flux only", ["flux"])):
         start = time.perf_counter()
         inv = spacepol.invert_lightcurve(csv, TLE, site, case["start"], case["end"], target=unknown,
-                                         materials=list(LIBRARY), observables=observables, live=live, seed=seed)
+                                         materials=list(LIBRARY), observables=observables, live=live, seed=seed,
+                                         progress=True)
         ranking = inv.ranking
         rank = [r["material"] for r in ranking].index(case["material"]) + 1
         rival = ranking[1] if rank == 1 else ranking[0]

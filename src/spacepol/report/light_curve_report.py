@@ -61,8 +61,8 @@ LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider tha
 
 def verdict_text(content: dict) -> str:
     """The report's verdict in words from lightcurve.json's ``content``: the material the curve reads as and by how
-    much, and every caution the fits carry (few effective draws, restarted explorations, an attitude sampled in a second run,
-    offsets the curve does not determine)."""
+    much, and every caution the fits carry (few effective draws, restarted explorations, an attitude sampled in a
+    second run, offsets the curve does not determine)."""
     second = content["ranking"][1] if len(content["ranking"]) > 1 else None
     verdict = f"The light curve reads as {content['best']}"
     if second is not None:

@@ -5,7 +5,8 @@ For each case a four-face box (faces of unequal areas) of one library material (
 material's own priors) under a random attitude offset (each angle uniform within 40 deg) is rendered by
 ``synth_pass`` and inverted by ``invert_lightcurve`` against all four materials, once with flux, DoLP and AoP and
 once with the flux alone (the control that makes the paper's point). Printed per case: the true material's rank and
-its ELPD-LOO gap to the runner-up in SEs of the paired difference (goal: first by >= 2 SE), each attitude offset's
+its ELPD-LOO gap to the runner-up in SEs of the paired difference (goal: first by >= 2 SE), the curve's times and
+median signal-to-noise of flux and DoLP (what it can carry), each attitude offset's
 90 % interval against the truth (goal: it holds the truth and is narrower than 30 deg), the ln Z gap, nested
 sampling's effective draws; then the coverage of all 90 % intervals (the attitude posterior's calibration) and the
 two gaps side by side.
@@ -91,7 +92,9 @@ def run_case(case: dict, folder: Path, live: int, seed: int) -> dict:
     curve = spacepol.synth_pass(TLE, site, case["start"], case["end"], target=box_toml(folder / "true.toml", case["truth"],
                                 case["attitude"]), step_s=20.0, seed=seed, out=csv)
     unknown = box_toml(folder / "unknown.toml", None, None)
-    row = {"times": len(curve)}
+    # what the curve can carry: a pass of few times with its polarization at the noise cannot separate the materials
+    row = {"times": len(curve), "flux_snr": float(np.median(curve.flux / curve.flux_err)),
+           "dolp_snr": float(np.median(np.abs(curve.dolp) / curve.dolp_err))}
     for label, observables in (("polarization", None), ("flux only", ["flux"])):
         start = time.perf_counter()
         inv = spacepol.invert_lightcurve(csv, TLE, site, case["start"], case["end"], target=unknown,
@@ -141,7 +144,7 @@ def main() -> None:
             covered.append(q["q05"] <= case["attitude"][a] <= q["q95"])
             widths.append(q["q95"] - q["q05"])
             intervals.append(f"{a[:-4]} {case['attitude'][a]:+.1f} in [{q['q05']:+.2f}, {q['q95']:+.2f}]")
-        print(f"{case['material']:<12s} {case['site']:<11s} {case['sky']:<8s} {row['times']:3d} times: rank {pol['rank']} "
+        print(f"{case['material']:<12s} {case['site']:<11s} {case['sky']:<8s} {row['times']:3d} times (median SNR: flux {row['flux_snr']:.0f}, DoLP {row['dolp_snr']:.1f}): rank {pol['rank']} "
               f"gap {pol['gap_se']:+.1f} SE (flux only: rank {flux['rank']}, {flux['gap_se']:+.1f} SE); "
               f"{'; '.join(intervals)}; ln Z gap {pol['log_evidence_gap']:+.1f} (flux only {flux['log_evidence_gap']:+.1f}); "
               f"effective draws >= {pol['effective_min']:.0f}; {pol['seconds']:.0f} + {flux['seconds']:.0f} s",

@@ -24,6 +24,11 @@ BOX_DEG = 15.0  # the search box's half width about the mirrored attitude
 MIRROR = {"yaw_deg": -1.0, "pitch_deg": 1.0, "roll_deg": -1.0}
 
 
+def attitude_words(attitude: dict) -> str:
+    """{angle name: deg} in words: "yaw 12.0, pitch -3.5, roll 0.2"."""
+    return ", ".join(f"{name.removesuffix('_deg')} {value:.1f}" for name, value in attitude.items())
+
+
 @dataclass(frozen=True)
 class AttitudeMode:
     """The attitude the draws miss (``attitude``: {angle: deg}), the full parameter row (``theta``), its log
@@ -68,8 +73,8 @@ def unsampled_mode(log_posterior, names: list[str], bounds, draws: np.ndarray, d
     if value < best_value - MARGIN or distance <= SEPARATED:
         return None
     attitude = {names[j]: float(theta[j]) for j in columns}
-    at = ", ".join(f"{k.removesuffix('_deg')} {v:.1f}" for k, v in attitude.items())
-    drawn = ", ".join(f"{names[j].removesuffix('_deg')} {best[j]:.1f}" for j in columns)
+    at = attitude_words(attitude)
+    drawn = attitude_words({names[j]: best[j] for j in columns})
     finding = (f"a second attitude ({at} deg) fits {'as well as' if value <= best_value else 'better than'} the best "
                f"draw ({drawn} deg; log posterior {value - best_value:+.1f}) and lies outside every draw: the draws "
                "hold one of two attitudes only, so the attitude's intervals may exclude the truth (more --live points "

@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import ParameterError, SamplerStalled
 from ..infer.diagnostics import loo
 from ..orbit.attitude import ANGLES
+from .attitude_modes import attitude_words
 from .light_curve_likelihood import pointwise, replicates
 from .light_curve_model import LightCurveModel
 from .target import linear_polarization
@@ -139,18 +140,19 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
 
     run = _nested(model, log_likelihood, _rescaling(model), live, rng, clock, f"material {name}")
     kept = _equal_draws(run, rng)
-    missed, added = _unsampled_attitude(model, curve, observables, kept, rng), None
+    ll = pointwise_log_likelihood(model, curve, observables, kept)
+    missed = _unsampled_attitude(model, curve, observables, kept, ll.sum(axis=1) + model.log_prior(kept), rng)
+    added = None
     if missed is not None:
         if progress:
-            at = ", ".join(f"{a.removesuffix('_deg')} {v:.1f}" for a, v in missed.attitude.items())
-            print(f"  {name}: a second attitude ({at} deg) outside every draw fits about as well; sampling it on its own",
-                  file=sys.stderr)
+            print(f"  {name}: a second attitude ({attitude_words(missed.attitude)} deg) outside every draw fits about "
+                  "as well; sampling it on its own", file=sys.stderr)
         box = _mode_box(model, missed.attitude)
         second = _nested(model, log_likelihood, _rescaling(model, box), live, rng, clock,
                          f"material {name}, its second attitude")
         run, added = _joined(model, run, second, box, missed)
         kept = _equal_draws(run, rng)
-    ll = pointwise_log_likelihood(model, curve, observables, kept)
+        ll = pointwise_log_likelihood(model, curve, observables, kept)
     labels = [f"{observable}[{t:%H:%M:%S}]" for observable in observables for t in curve.times_utc]
     record = loo(az.from_dict(posterior={n: kept[None, :, j] for j, n in enumerate(model.names)},
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
@@ -224,8 +226,13 @@ def _mode_box(model: LightCurveModel, attitude: dict) -> np.ndarray:
     """(3, 2) the angles within ``attitude_modes.BOX_DEG`` of ``attitude``, inside the prior."""
     from .attitude_modes import BOX_DEG
 
-    bounds = [model.priors[model.names.index(a)].bounds for a in ANGLES]
-    return np.array([[max(lo, attitude[a] - BOX_DEG), min(hi, attitude[a] + BOX_DEG)] for a, (lo, hi) in zip(ANGLES, bounds)])
+    return np.array([[max(lo, attitude[a] - BOX_DEG), min(hi, attitude[a] + BOX_DEG)]
+                     for a, (lo, hi) in zip(ANGLES, _angle_bounds(model))])
+
+
+def _angle_bounds(model: LightCurveModel) -> np.ndarray:
+    """(3, 2) the attitude angles' prior bounds (deg)."""
+    return np.array([model.priors[model.names.index(a)].bounds for a in ANGLES], float)
 
 
 def _joined(model: LightCurveModel, first: _Run, second: _Run, box: np.ndarray, mode) -> tuple[_Run, dict]:
@@ -236,24 +243,23 @@ def _joined(model: LightCurveModel, first: _Run, second: _Run, box: np.ndarray, 
     from scipy.special import logsumexp
 
     columns = [model.names.index(a) for a in ANGLES]
-    bounds = np.array([model.priors[j].bounds for j in columns], float)
+    bounds = _angle_bounds(model)
     inside = np.all((first.points[:, columns] >= box[:, 0]) & (first.points[:, columns] <= box[:, 1]), axis=1)
     box_prior = float(np.sum(np.log((box[:, 1] - box[:, 0]) / (bounds[:, 1] - bounds[:, 0]))))
     second_mass = second.log_mass + box_prior
     log_mass = np.concatenate([first.log_mass[~inside], second_mass])
     log_z = float(logsumexp(log_mass))
     share = float(np.exp(logsumexp(second_mass) - log_z))
-    at = ", ".join(f"{a.removesuffix('_deg')} {v:.1f}" for a, v in mode.attitude.items())
     added = {"attitude": mode.attitude, "share": share, "log_posterior": mode.log_posterior,
-             "finding": f"a second attitude ({at} deg) the exploration missed was sampled on its own and holds "
-                        f"{100 * share:.0f} % of the posterior"}
+             "finding": f"a second attitude ({attitude_words(mode.attitude)} deg) the exploration missed was sampled on "
+                        f"its own and holds {100 * share:.0f} % of the posterior"}
     joined = _Run(np.concatenate([first.points[~inside], second.points]), log_mass, log_z,
                   first.calls + second.calls, first.restarts + second.restarts)
     return joined, added
 
 
 def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], draws: np.ndarray,
-                        rng: np.random.Generator):
+                        draws_log_posterior: np.ndarray, rng: np.random.Generator):
     """``attitude_modes.unsampled_mode`` of a fit's draws (an ``AttitudeMode``; None where the draws miss none or the
     attitude is known)."""
     from .attitude_modes import unsampled_mode
@@ -265,7 +271,7 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
         return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
 
     return unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws,
-                          log_posterior(draws), rng)
+                          draws_log_posterior, rng)
 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:

@@ -10,13 +10,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import erfc, erfcx, i0e
 
+from ..observables.aop import wrap_deg
+
 _LOG_SQRT_2PI = 0.5 * np.log(2.0 * np.pi)
 _TINY = 1e-300
-
-
-def wrapped_aop(difference):
-    """An AoP difference (deg) on its 180-deg circle, in [-90, 90)."""
-    return (difference + 90.0) % 180.0 - 90.0
 
 
 def _gaussian(residual, error):
@@ -59,25 +56,23 @@ def pointwise(curve, observables: list[str], mu: dict) -> np.ndarray:
     both = "dolp" in observables and "aop_deg" in observables
     if both:
         difference = np.radians(2.0 * (curve.aop_deg - theta0))
-        # in units of q, u; a DoLP measured negative (its flux below zero, in the noise) lies across the origin
-        across = 2.0 * np.maximum(np.abs(curve.dolp), _TINY) * np.radians(curve.aop_err_deg)
         terms["dolp"] = _gaussian(curve.dolp - p0 * np.cos(difference), curve.dolp_err)
-        terms["aop_deg"] = (-0.5 * (p0 * np.sin(difference) / across) ** 2 - np.log(curve.aop_err_deg) - _LOG_SQRT_2PI)
+        terms["aop_deg"] = (-0.5 * (p0 * np.sin(difference) / _across(curve)) ** 2 - np.log(curve.aop_err_deg)
+                            - _LOG_SQRT_2PI)
     elif "dolp" in observables:
         terms["dolp"] = rice_log_pdf(curve.dolp, p0, curve.dolp_err)
     elif "aop_deg" in observables:
-        difference = wrapped_aop(curve.aop_deg - theta0)
+        difference = wrap_deg(curve.aop_deg - theta0)
         if curve.dolp is None:
             terms["aop_deg"] = _gaussian(difference, curve.aop_err_deg)
         else:
-            terms["aop_deg"] = angle_log_pdf(difference, p0, _noise(curve))
+            terms["aop_deg"] = angle_log_pdf(difference, p0, curve.dolp_err)
     return np.concatenate([np.broadcast_to(terms[name], p0.shape) for name in observables], axis=1)
 
 
-def _noise(curve) -> np.ndarray:
-    """(T,) the per-component noise of q and u: the DoLP's error, or where none is given 2 DoLP x the AoP's error."""
-    if curve.dolp_err is not None:
-        return curve.dolp_err
+def _across(curve) -> np.ndarray:
+    """(T,) the AoP's error in units of q and u: 2 DoLP x the AoP's error (rad); a DoLP measured negative (its flux
+    below zero, in the noise) lies across the origin, so by its size."""
     return 2.0 * np.maximum(np.abs(curve.dolp), _TINY) * np.radians(curve.aop_err_deg)
 
 
@@ -90,7 +85,7 @@ def replicates(curve, mu: dict, rng: np.random.Generator) -> dict:
         out["flux"] = np.nan_to_num(mu["flux"]) + curve.flux_err * rng.standard_normal(mu["flux"].shape)
     if curve.dolp is not None or curve.aop_deg is not None:
         p0, theta0 = np.nan_to_num(mu["dolp"]), np.radians(2.0 * np.nan_to_num(mu["aop_deg"]))
-        sigma = _noise(curve) if curve.dolp is not None else 2.0 * p0 * np.radians(curve.aop_err_deg)
+        sigma = curve.dolp_err if curve.dolp is not None else 2.0 * p0 * np.radians(curve.aop_err_deg)
         q = p0 * np.cos(theta0) + sigma * rng.standard_normal(p0.shape)
         u = p0 * np.sin(theta0) + sigma * rng.standard_normal(p0.shape)
         if curve.dolp is not None:

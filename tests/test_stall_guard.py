@@ -83,3 +83,30 @@ def test_the_command_line_says_a_stall_in_one_line_with_status_1(monkeypatch, ca
     assert cli.main(["effects"]) == 1
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("invert-mcmc: material kapton: nested sampling stalled"), err
+
+
+def test_ctrl_c_swallowed_inside_the_sampler_is_raised_again_at_the_next_likelihood_call():
+    import os
+    import signal
+
+    def swallowed_interrupt():
+        # as scikit-learn's MLP training inside nautilus does: Ctrl-C caught, a warning, training goes on
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)
+        except KeyboardInterrupt:
+            return True
+        return False
+
+    clock = CallClock()
+    with pytest.raises(KeyboardInterrupt):
+        with stall_guard(clock, "material kapton", seconds=30.0, poll_seconds=0.05):
+            assert swallowed_interrupt()
+            clock.tick()
+    handler = signal.getsignal(signal.SIGINT)
+    assert handler is signal.default_int_handler, handler  # put back as it was
+    # the control: without the guard, the swallowed interrupt is lost and the next call goes on
+    clock = CallClock()
+    assert swallowed_interrupt()
+    clock.tick()
+    assert clock.calls == 1

@@ -7,12 +7,14 @@ likelihood rarely or never, so neither a call budget nor nautilus' own ``timeout
 it. Two signs, each far from a healthy run: no likelihood call for ``STALL_SECONDS``, or the newest shell's bound
 keeping fewer than ``MIN_ACCEPTANCE`` of ``MIN_DRAWS`` or more points drawn (a healthy shell keeps 1-50 %). The
 watchdog thread then raises ``SamplerStalled`` in the sampling thread (``PyThreadState_SetAsyncExc``, delivered at
-the next Python instruction of the rejection loop, which is Python code).
+the next Python instruction of the rejection loop, which is Python code). Ctrl-C is kept too: scikit-learn's network
+training swallows a KeyboardInterrupt, so the guard notes it and raises it again at the next likelihood call.
 """
 
 from __future__ import annotations
 
 import ctypes
+import signal
 import threading
 import time
 from contextlib import contextmanager
@@ -32,11 +34,35 @@ class CallClock:
     def __init__(self):
         self.last = time.monotonic()
         self.calls = 0
+        self.interrupted = False
 
     def tick(self) -> None:
-        """Record a likelihood call now."""
+        """Record a likelihood call now; raise ``KeyboardInterrupt`` where Ctrl-C came since (``stall_guard``)."""
+        if self.interrupted:
+            raise KeyboardInterrupt
         self.last = time.monotonic()
         self.calls += 1
+
+
+@contextmanager
+def _interrupts_kept(clock: CallClock):
+    """Within the block, Ctrl-C raises KeyboardInterrupt as usual and also marks ``clock``, whose next ``tick``
+    raises it again: code that catches and drops the first (scikit-learn's MLP training, inside nautilus) cannot
+    swallow it. Outside the main thread, where signals cannot be handled, the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupted(signum, frame):
+        clock.interrupted = True
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupted)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        clock.interrupted = False
 
 
 def _raise_in(thread_id: int, exception: type[BaseException]) -> None:
@@ -80,7 +106,8 @@ def stall_guard(clock: CallClock, what: str, sampler=None, seconds: float = STAL
     watchdog.start()
     try:
         try:
-            yield clock
+            with _interrupts_kept(clock):
+                yield clock
         finally:
             with lock:
                 state["active"] = False

@@ -110,6 +110,7 @@ def run_case(case: dict, folder: Path, live: int, seed: int) -> dict:
         row[label] = {"rank": rank, "gap_se": diff / se if se > 0 else float("inf"), "gap": diff,
                       "attitude": {a: fit[a] for a in ANGLES}, "seconds": time.perf_counter() - start,
                       "effective_min": min(f.effective_draws for f in inv.fits),
+                      "ended_early": [f.material for f in inv.fits if f.exploration_ended_early],
                       "log_evidence_gap": true_row["delta_log_evidence"] - rival["delta_log_evidence"]}
     return row
 
@@ -147,7 +148,9 @@ def main() -> None:
         print(f"{case['material']:<12s} {case['site']:<11s} {case['sky']:<8s} {row['times']:3d} times (median SNR: flux {row['flux_snr']:.0f}, DoLP {row['dolp_snr']:.1f}): rank {pol['rank']} "
               f"gap {pol['gap_se']:+.1f} SE (flux only: rank {flux['rank']}, {flux['gap_se']:+.1f} SE); "
               f"{'; '.join(intervals)}; ln Z gap {pol['log_evidence_gap']:+.1f} (flux only {flux['log_evidence_gap']:+.1f}); "
-              f"effective draws >= {pol['effective_min']:.0f}; {pol['seconds']:.0f} + {flux['seconds']:.0f} s",
+              f"effective draws >= {pol['effective_min']:.0f}; explorations ended where they stood: "
+              f"{', '.join(pol['ended_early']) or 'none'} (flux only: {', '.join(flux['ended_early']) or 'none'}); "
+              f"{pol['seconds']:.0f} + {flux['seconds']:.0f} s",
               flush=True)
     n = len(covered)
     if not n:

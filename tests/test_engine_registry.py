@@ -206,8 +206,58 @@ def test_sampling_after_the_exploration_stops_at_its_likelihood_budget():
         return s
 
     capped = sampler()
-    assert not explore_then_sample(capped, effective_draws=10**6, clock=clock, what="test", calls_per_live_point=4)
-    spent = capped.n_like - capped.calls_before[1]  # after the exploration
+    outcome = explore_then_sample(capped, effective_draws=10**6, clock=clock, what="test", calls_per_live_point=4)
+    assert outcome.explored and not outcome.draws_reached
+    spent = capped.n_like - capped.calls_before[-1]  # the sampling phase, the last run
     assert 4 * 50 <= spent <= 4 * 50 + 50, (capped.calls_before, spent)  # nautilus stops at the first batch past it
     reached = sampler()
-    assert explore_then_sample(reached, effective_draws=150, clock=clock, what="test", calls_per_live_point=4), reached.n_eff
+    outcome = explore_then_sample(reached, effective_draws=150, clock=clock, what="test", calls_per_live_point=4)
+    assert outcome.explored and outcome.draws_reached, reached.n_eff
+
+
+def test_an_exploration_that_adds_no_shell_is_ended_where_it_stands_and_its_evidence_still_holds():
+    """``explore_then_sample`` ends an exploration that adds no shell in ``stuck_calls_per_live_point`` calls per live
+    point (nautilus rejecting every new bound as no smaller: here forced after three shells) and samples the shells it
+    has; ln Z of a 2-d Gaussian (sigma 0.03 in the unit square: ln 2 pi sigma^2 = -5.175) still within 0.4 of the truth
+    (between seeds it scatters by 0.08 so stopped; 0.01 when explored). Controls: the same run unforced ends by
+    nautilus' own criterion; stepped exploration leaves the very points one run does."""
+    from nautilus import Sampler
+
+    from spacepol.infer.engines.nested import _explore, explore_then_sample
+    from spacepol.infer.engines.stall_guard import CallClock
+
+    clock = CallClock()
+
+    def log_likelihood(x):
+        clock.tick()
+        return -0.5 * np.sum(((x - 0.5) / 0.03) ** 2, axis=-1)
+
+    class Stuck(Sampler):
+        def add_bound(self, verbose=False):
+            if len(self.bounds) >= 3:
+                return False
+            self.last_shell_at = self.n_like
+            return super().add_bound(verbose)
+
+        def run(self, **options):
+            self.sampling_from = self.n_like  # the last run samples the shells
+            return super().run(**options)
+
+    def run(kind):
+        s = kind(lambda u: u, log_likelihood, n_dim=2, n_live=50, n_networks=1, vectorized=True, seed=0)
+        return s, explore_then_sample(s, 800, clock, "test", calls_per_live_point=40, stuck_calls_per_live_point=20)
+
+    stuck, outcome = run(Stuck)
+    assert not outcome.explored and stuck.explored and len(stuck.bounds) == 3
+    exploring = stuck.sampling_from - stuck.last_shell_at  # from the last shell to the end of the exploration
+    # the limit (1,000), the batch (100) of the step that added the shell and the one that ends it, a batch to fill
+    # each shell: 1,500 at most; a batch more as margin
+    assert 20 * 50 <= exploring <= 20 * 50 + 2 * 100 + 3 * 100 + 100, exploring
+    assert abs(stuck.log_z - np.log(2 * np.pi * 0.03**2)) < 0.4, stuck.log_z
+    healthy, outcome = run(Sampler)
+    assert outcome.explored and outcome.draws_reached and len(healthy.bounds) > 3
+    one = Sampler(lambda u: u, log_likelihood, n_dim=2, n_live=50, n_networks=1, vectorized=True, seed=1)
+    stepped = Sampler(lambda u: u, log_likelihood, n_dim=2, n_live=50, n_networks=1, vectorized=True, seed=1)
+    one.run(n_eff=0, discard_exploration=True, verbose=False)
+    assert _explore(stepped, 10**9)
+    assert one.n_like == stepped.n_like and np.array_equal(one.posterior()[0], stepped.posterior()[0])

@@ -122,16 +122,19 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     # a candidate whose sampler ran out of its budget short of the draws is named in the verdict; the run's are not
     report = (folder / "fit" / "report.html").read_text()
     assert "Few effective draws" not in report and "restart" not in report and "second attitude" not in report
+    assert "ended where it stood" not in report
     rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "kapton" else f for f in inversion.fits])
     assert "Few effective draws (under 200) for kapton (3)" in verdict_text(rough.to_json())
-    # a restarted exploration and an attitude sampled in a second run are named too, and survive a save and a load
+    # a restarted exploration, one ended where it stood and an attitude sampled in a second run are named too, and
+    # survive a save and a load
     added = {"attitude": {"yaw_deg": -40.0, "pitch_deg": 5.0, "roll_deg": 2.0}, "share": 0.4, "log_posterior": -10.0,
              "finding": "a second attitude (yaw -40.0, pitch 5.0, roll 2.0 deg) the exploration missed was sampled"}
-    replace(best, restarts=1, added_attitude=added).save(folder / "marked.npz", "key")
+    replace(best, restarts=1, added_attitude=added, exploration_ended_early=True).save(folder / "marked.npz", "key")
     loaded = MaterialFit.load(folder / "marked.npz", "key")
-    assert loaded.restarts == 1 and loaded.added_attitude == added
+    assert loaded.restarts == 1 and loaded.added_attitude == added and loaded.exploration_ended_early
     text = verdict_text(replace(inversion, fits=[loaded if f is best else f for f in inversion.fits]).to_json())
     assert "solar_glass (1 restart)" in text and "For solar_glass, a second attitude (yaw -40.0" in text, text
+    assert "exploration of solar_glass added no shell" in text, text
 
 
 @pytest.mark.parametrize("change, words", [

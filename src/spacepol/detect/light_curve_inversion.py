@@ -58,9 +58,10 @@ class MaterialFit:
     """One candidate's posterior: ``names``, ``samples`` (equally weighted draws, D), the ELPD-LOO record (``loo``:
     elpd_loo, elpd_loo_se, p_loo, pareto_k, pointwise), nested sampling's ``log_evidence`` (ln Z), its weighted
     points' ``effective_draws`` and its ``likelihood_calls``, the posterior-predictive bands {observable: (3, T)
-    5/50/95 %}, ``seconds``, the ``restarts`` a stalled exploration took (``STALL_RESTARTS``), and the attitude mode
+    5/50/95 %}, ``seconds``, the ``restarts`` a stalled exploration took (``STALL_RESTARTS``), the attitude mode
     the exploration missed and a second run sampled (``fit_material``: its attitude, share of the posterior and a
-    finding in words; None where there was none)."""
+    finding in words; None where there was none), and whether an exploration that added no shell was ended where it
+    stood (its ln Z and draws then rough)."""
 
     material: str
     description: str
@@ -74,6 +75,7 @@ class MaterialFit:
     seconds: float
     restarts: int = 0
     added_attitude: dict | None = None
+    exploration_ended_early: bool = False
 
     def save(self, path, key: str) -> None:
         """This fit in one .npz file (written whole or not at all), labelled with ``key`` (what it was fitted to)."""
@@ -83,6 +85,7 @@ class MaterialFit:
                    "log_evidence": self.log_evidence, "effective_draws": self.effective_draws,
                    "likelihood_calls": self.likelihood_calls,
                    "seconds": self.seconds, "restarts": self.restarts, "added_attitude": self.added_attitude,
+                   "exploration_ended_early": self.exploration_ended_early,
                    "loo": {k: v for k, v in self.loo.items() if np.ndim(v) == 0 or k == "pareto_k_bad"}}
         arrays = {"samples": self.samples, "pointwise": self.loo["pointwise"], "pareto_k": self.loo["pareto_k"]}
         arrays |= {f"band_{k}": v for k, v in self.bands.items()}
@@ -103,7 +106,8 @@ class MaterialFit:
                 record = scalars["loo"] | {"pointwise": f["pointwise"], "pareto_k": f["pareto_k"]}
                 return cls(scalars["material"], scalars["description"], scalars["names"], f["samples"], record,
                            scalars["log_evidence"], scalars["effective_draws"], scalars["likelihood_calls"], bands, scalars["seconds"],
-                           scalars.get("restarts", 0), scalars.get("added_attitude"))
+                           scalars.get("restarts", 0), scalars.get("added_attitude"),
+                           scalars.get("exploration_ended_early", False))
         except (OSError, ValueError, KeyError, EOFError):
             return None
 
@@ -158,19 +162,21 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
                               log_likelihood={"y": ll[None]}, coords={"obs_id": labels}, dims={"y": ["obs_id"]}))
     return MaterialFit(name, model.material.description, list(model.names), kept, record, run.log_z,
                        kish_draws(run.log_mass), run.calls, _bands(model, curve, kept[:200], rng),
-                       time.perf_counter() - start, run.restarts, added)
+                       time.perf_counter() - start, run.restarts, added, run.exploration_ended_early)
 
 
 @dataclass
 class _Run:
     """Weighted points of nested sampling: ``log_mass`` each point's ln share of the evidence (its normalised weight
-    times Z), ``log_z`` their ln sum, the likelihood ``calls`` and the ``restarts`` of stalled explorations."""
+    times Z), ``log_z`` their ln sum, the likelihood ``calls``, the ``restarts`` of stalled explorations, and whether
+    an exploration was ended where it stood (``infer.engines.nested.explore_then_sample``)."""
 
     points: np.ndarray
     log_mass: np.ndarray
     log_z: float
     calls: int
     restarts: int
+    exploration_ended_early: bool = False
 
 
 def _rescaling(model: LightCurveModel, box: np.ndarray | None = None):
@@ -194,13 +200,13 @@ def _nested(model: LightCurveModel, log_likelihood, rescale, live: int, rng: np.
     from nautilus import Sampler
     from scipy.special import logsumexp
 
-    from ..infer.engines.nested import explore_then_sample
+    from ..infer.engines.nested import STUCK_CALLS_PER_LIVE_POINT, explore_then_sample
 
     for restarts in range(STALL_RESTARTS + 1):
         sampler = Sampler(rescale, log_likelihood, n_dim=model.ndim, n_live=live * 2**restarts, n_networks=1,
                           vectorized=True, seed=int(rng.integers(2**31)))
         try:
-            explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, what)
+            outcome = explore_then_sample(sampler, EFFECTIVE_DRAWS, clock, what)
             break
         except SamplerStalled as stalled:
             if restarts == STALL_RESTARTS:
@@ -210,7 +216,10 @@ def _nested(model: LightCurveModel, log_likelihood, rescale, live: int, rng: np.
                   file=sys.stderr)
     points, log_w, _ = sampler.posterior()
     log_z = float(sampler.log_z)
-    return _Run(points, log_w - logsumexp(log_w) + log_z, log_z, int(sampler.n_like), restarts)
+    if not outcome.explored:
+        print(f"  {what}: the exploration added no shell in {STUCK_CALLS_PER_LIVE_POINT} likelihood calls per live point "
+              "and was ended where it stood; its ln Z and draws are rough", file=sys.stderr)
+    return _Run(points, log_w - logsumexp(log_w) + log_z, log_z, int(sampler.n_like), restarts, not outcome.explored)
 
 
 def _equal_draws(run: _Run, rng: np.random.Generator) -> np.ndarray:
@@ -254,7 +263,8 @@ def _joined(model: LightCurveModel, first: _Run, second: _Run, box: np.ndarray, 
              "finding": f"a second attitude ({attitude_words(mode.attitude)} deg) the exploration missed was sampled on "
                         f"its own and holds {100 * share:.0f} % of the posterior"}
     joined = _Run(np.concatenate([first.points[~inside], second.points]), log_mass, log_z,
-                  first.calls + second.calls, first.restarts + second.restarts)
+                  first.calls + second.calls, first.restarts + second.restarts,
+                  first.exploration_ended_early or second.exploration_ended_early)
     return joined, added
 
 
@@ -355,6 +365,7 @@ class LightCurveInversion:
                                             "likelihood_calls": f.likelihood_calls,
                                             "p_loo": f.loo["p_loo"], "pareto_k_max": float(np.max(f.loo["pareto_k"])),
                                             "seconds": f.seconds, "restarts": f.restarts,
-                                            "added_attitude": f.added_attitude} for f in self.fits},
+                                            "added_attitude": f.added_attitude,
+                                            "exploration_ended_early": f.exploration_ended_early} for f in self.fits},
                 "times_utc": [t.strftime("%Y-%m-%dT%H:%M:%SZ") for t in self.curve.times_utc],
                 "assumptions": self.assumptions}

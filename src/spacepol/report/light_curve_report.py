@@ -62,7 +62,7 @@ LOOSE_ATTITUDE_DEG = 30.0  # an attitude offset whose 90 % interval is wider tha
 def verdict_text(content: dict) -> str:
     """The report's verdict in words from lightcurve.json's ``content``: the material the curve reads as and by how
     much, and every caution the fits carry (few effective draws, restarted explorations, an attitude sampled in a
-    second run, offsets the curve does not determine)."""
+    second run, explorations ended where they stood, offsets the curve does not determine)."""
     second = content["ranking"][1] if len(content["ranking"]) > 1 else None
     verdict = f"The light curve reads as {content['best']}"
     if second is not None:
@@ -84,6 +84,11 @@ def verdict_text(content: dict) -> str:
     if restarted:
         verdict += (f" Nested sampling's exploration stalled and started again from the prior with twice the live "
                     f"points for {', '.join(restarted)} (its neural bound rejected nearly every point drawn).")
+    cut = [m for m, c in content["candidates"].items() if c.get("exploration_ended_early")]
+    if cut:
+        verdict += (f" Nested sampling's exploration of {', '.join(cut)} added no shell over a long run (a thin curved "
+                    "ridge its bounds could not follow) and was ended where it stood: those ln Z, ELPD-LOO and "
+                    "posteriors are rough, the more so the fewer effective draws they have.")
     added = content["candidates"][content["best"]].get("added_attitude")
     if added:
         verdict += f" For {content['best']}, {added['finding']}."

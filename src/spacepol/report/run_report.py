@@ -106,6 +106,9 @@ def _html(inv, data_path, out, figures, truths, notes) -> str:
         verdict += f" Log evidence ln Z = {s.log_evidence['value']:.2f} +- {s.log_evidence['error']:.2f}."
     if s.sampler.get("missed_mode"):
         verdict += f" NOT the whole posterior: {s.sampler['missed_mode']['finding']}."
+    if s.sampler.get("explorations_ended_early"):
+        verdict += (f" In {s.sampler['explorations_ended_early']} nested-sampling replicate(s) the exploration added no "
+                    "shell over a long run and was ended where it stood: ln Z and the draws are rough.")
     if s.sampler.get("capped"):
         verdict += f" The chain hit the step cap ({s.sampler['steps']} steps) before reaching 50 autocorrelation times."
     sections = [

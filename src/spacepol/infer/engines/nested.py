@@ -10,8 +10,8 @@ The reasoning behind it, and what was measured: the internals page of the docume
 from __future__ import annotations
 
 import sys
-
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import logsumexp
@@ -36,21 +36,53 @@ def kish_draws(log_w) -> float:
 
 # after the exploration, at most this many likelihood calls per live point go into reaching the effective draws
 SAMPLING_CALLS_PER_LIVE_POINT = 100
+# likelihood calls per live point without a new shell that end an exploration where it stands
+STUCK_CALLS_PER_LIVE_POINT = 100
+
+
+@dataclass(frozen=True)
+class NestedOutcome:
+    """How a nautilus run ended: whether its points reached the effective draws asked for, and whether its
+    exploration ended by nautilus' own criterion (False: no new shell in ``STUCK_CALLS_PER_LIVE_POINT`` calls per
+    live point, so the run was sampled from the shells it had)."""
+
+    draws_reached: bool
+    explored: bool
+
+
+def _explore(sampler, stuck_calls: int) -> bool:
+    """Run ``sampler``'s exploration in steps of one live set's worth of calls, to its end or until ``stuck_calls``
+    calls pass without a new shell; then end it where it stands. Whether it ended by nautilus' own criterion. The
+    steps change nothing else: nautilus keeps its whole state between ``run`` calls."""
+    shells, since = len(sampler.bounds), sampler.n_like
+    while not sampler.explored:
+        sampler.run(n_eff=0, discard_exploration=True, verbose=False, n_like_max=sampler.n_like + sampler.n_live)
+        if len(sampler.bounds) != shells:
+            shells, since = len(sampler.bounds), sampler.n_like
+        elif not sampler.explored and sampler.n_like - since >= stuck_calls:
+            # f_live is a fraction, so any bound above 1 ends the exploration at the next batch
+            sampler.run(f_live=2.0, n_eff=0, discard_exploration=True, verbose=False)
+            return False
+    sampler.run(n_eff=0, discard_exploration=True, verbose=False)  # every shell holds a point, as one run leaves it
+    return True
 
 
 def explore_then_sample(sampler, effective_draws: int, clock: CallClock, what: str,
-                        calls_per_live_point: int = SAMPLING_CALLS_PER_LIVE_POINT) -> bool:
+                        calls_per_live_point: int = SAMPLING_CALLS_PER_LIVE_POINT,
+                        stuck_calls_per_live_point: int = STUCK_CALLS_PER_LIVE_POINT) -> NestedOutcome:
     """Run a nautilus ``sampler``'s exploration to its end, then sample its shells until the points are worth
-    ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent; whether
-    the draws were reached. The cap matters where a posterior is far narrower than the last shell: there the points
-    gain almost no effective draws per call, and an uncapped run goes on for hours. ``clock``: ticked by the
-    sampler's likelihood; a run that stops making progress stops with ``SamplerStalled`` naming ``what``
-    (``stall_guard``)."""
+    ``effective_draws`` or ``calls_per_live_point`` likelihood calls per live point more have been spent. The cap
+    matters where a posterior is far narrower than the last shell: there the points gain almost no effective draws
+    per call, and an uncapped run goes on for hours. An exploration that adds no shell in
+    ``stuck_calls_per_live_point`` calls per live point is ended where it stands (a thin curved ridge the shells'
+    ellipsoids cannot follow: nautilus rejects every new bound as no smaller than the last, and would call the
+    likelihood without end). ``clock``: ticked by the sampler's likelihood; a run that stops making progress stops
+    with ``SamplerStalled`` naming ``what`` (``stall_guard``)."""
     with stall_guard(clock, what, sampler):
-        sampler.run(n_eff=0, discard_exploration=True, verbose=False)
+        explored = _explore(sampler, stuck_calls_per_live_point * sampler.n_live)
         sampler.run(n_eff=effective_draws, discard_exploration=True, verbose=False,
                     n_like_max=sampler.n_like + calls_per_live_point * sampler.n_live)
-    return sampler.n_eff >= effective_draws
+    return NestedOutcome(sampler.n_eff >= effective_draws, explored)
 
 
 def combine_evidence(log_z: np.ndarray) -> tuple[float, float]:
@@ -78,11 +110,13 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
         value = posterior.log_likelihood(np.atleast_2d(theta))
         return np.where(np.isfinite(value), value, -1e300)  # nautilus needs finite numbers
 
-    chains, log_z, effective, calls = [], [], [], 0
+    chains, log_z, effective, calls, ended_early = [], [], [], 0, 0
     for r in range(replicates):
         sampler = Sampler(priors.rescale, log_likelihood, n_dim=priors.ndim, n_live=live, n_networks=networks,
                           vectorized=True, seed=int(rng.integers(2**31)))
-        explore_then_sample(sampler, effective_draws, clock, f"replicate {r + 1} of {posterior.likelihood.model.name}")
+        what = f"replicate {r + 1} of {posterior.likelihood.model.name}"
+        explored = explore_then_sample(sampler, effective_draws, clock, what).explored
+        ended_early += not explored
         points, log_w, log_l = sampler.posterior()
         effective.append(kish_draws(log_w))
         log_z.append(float(sampler.log_z))
@@ -90,7 +124,8 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
         chains.append((points, log_w, log_l))
         if progress:
             print(f"  nested sampling {r + 1}/{replicates}: ln Z {sampler.log_z:.3f}, {effective[-1]:.0f} effective draws, "
-                  f"{time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
+                  f"{time.perf_counter() - start:.0f} s{'' if explored else ' (exploration ended where it stood: no new shell)'}",
+                  file=sys.stderr, flush=True)
     per_chain = int(min(max_draws_per_replicate, min(effective)))
     samples, log_prob = [], []
     for points, log_w, log_l in chains:
@@ -108,7 +143,7 @@ def sample_nested(posterior, rng: np.random.Generator, live: int = 500, replicat
                         info={"sampler": "nautilus", "live": live, "replicates": replicates, "networks": networks,
                               "log_evidence": value, "log_evidence_error": error, "log_evidence_replicates": log_z,
                               "effective_draws_per_replicate": effective, "draws_per_replicate": per_chain,
-                              "likelihood_calls": calls})
+                              "likelihood_calls": calls, "explorations_ended_early": ended_early})
 
 
 def missed_mode(posterior, draws: EngineResult, rng: np.random.Generator) -> dict | None:

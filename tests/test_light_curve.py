@@ -117,34 +117,64 @@ def daytime_pass(tmp_path_factory):
     return path, pass_geometry(read_tle(TLE), (43.1333, 125.5333, 200.0), START, END, 20.0, faces)
 
 
-def test_synthetic_errors_are_the_scatter_of_the_draws(daytime_pass):
-    """Over 400 noise draws of the pass, (measured - true) / stated error has mean 0 and SD 1 for the flux, and for
-    DoLP and AoP where the polarized signal is 20 errors or more (the delta method's range); the same residuals over
-    errors half as large (the negative control) are far from it. Tolerances: 5 Monte-Carlo SEs."""
-    _, geometry = daytime_pass
-    camera = replace(Camera(), exposure_s=1e-3)
+def _residuals(geometry, camera, exposures: int, draws: int, rng) -> dict:
+    """{flux, dolp, aop: (measured - true) / stated error} over ``draws`` noise draws of the pass; DoLP and AoP at
+    the times whose polarized signal is 20 errors or more (the delta method's range), chosen once from the truth."""
     light = target_light(geometry, None, {}, (1.5, 1.8))
     truth = light.stokes_w_m2[:3, 0, :] * light.photons_per_joule
     keep = (geometry.elevation_deg > 0) & geometry.sunlit & (truth[0] > 0)
     s0, dolp = truth[0][keep], np.hypot(truth[1], truth[2])[keep] / truth[0][keep]
     aop = 0.5 * np.degrees(np.arctan2(truth[2], truth[1]))[keep]
     z = {"flux": [], "dolp": [], "aop": []}
-    rng = np.random.default_rng(11)
-    # the times whose polarized signal is 20 errors or more, chosen once from the truth (not from each draw's noise)
-    bright = dolp / synthesized_light_curve(geometry, camera, rng, exposures=50).dolp_err > 20
-    for _ in range(400):
-        c = synthesized_light_curve(geometry, camera, rng, exposures=50)
+    bright = dolp / synthesized_light_curve(geometry, camera, rng, exposures=exposures).dolp_err > 20
+    for _ in range(draws):
+        c = synthesized_light_curve(geometry, camera, rng, exposures=exposures)
         z["flux"].append((c.flux - s0) / c.flux_err)
         z["dolp"].append(((c.dolp - dolp) / c.dolp_err)[bright])
         wrapped = (c.aop_deg - aop + 90.0) % 180.0 - 90.0
         z["aop"].append((wrapped / c.aop_err_deg)[bright])
-    for name, values in z.items():
-        v = np.concatenate(values)
-        n = v.size
-        assert n >= 1000, (name, n)
-        assert abs(v.mean()) < 5 / np.sqrt(n), (name, v.mean(), n)
-        assert abs(v.std() - 1) < 5 / np.sqrt(2 * n), (name, v.std(), n)
+    return {name: np.concatenate(values) for name, values in z.items()}
+
+
+def _standard_normal(v: np.ndarray, name: str) -> None:
+    """Mean 0 and SD 1 within 5 Monte-Carlo SEs, from at least 1,000 values."""
+    n = v.size
+    assert n >= 1000, (name, n)
+    assert abs(v.mean()) < 5 / np.sqrt(n), (name, v.mean(), n)
+    assert abs(v.std() - 1) < 5 / np.sqrt(2 * n), (name, v.std(), n)
+
+
+def test_synthetic_errors_are_the_scatter_of_the_draws(daytime_pass):
+    """Over 400 noise draws of the pass, (measured - true) / stated error has mean 0 and SD 1 for the flux, and for
+    DoLP and AoP where the polarized signal is 20 errors or more (the delta method's range); the same residuals over
+    errors half as large (the negative control) are far from it. Tolerances: 5 Monte-Carlo SEs."""
+    _, geometry = daytime_pass
+    z = _residuals(geometry, replace(Camera(), exposure_s=1e-3), 50, 400, np.random.default_rng(11))
+    for name, v in z.items():
+        _standard_normal(v, name)
         assert abs(2 * v.std() - 1) > 0.5  # errors half as large: the SD of the residuals over them is 2
+
+
+def test_a_bright_targets_errors_are_scintillation_and_the_polarimeters_calibration(daytime_pass):
+    """With 200 one-second frames per time the photon noise is far below the floors: the flux's stated error is
+    scintillation's and the DoLP's the calibration accuracy (0.005 here), and (measured - true) / stated error is N(0, 1)
+    over 300 draws (5 Monte-Carlo SEs). Control: a camera without the floors states errors several times smaller
+    than that scatter. Scintillation itself agrees with Young's original formula (0.09 D_cm^-2/3 X^1.75 (2t)^-1/2 at
+    sea level) to 10 % at the zenith with C_Y = 1."""
+    from spacepol.skylight.scintillation import scintillation_relative
+
+    young = 0.09 * 180.0 ** (-2 / 3) / np.sqrt(2 * 200.0)
+    assert abs(scintillation_relative(1.8, 90.0, 0.0, 200.0, correction=1.0) / young - 1) < 0.1
+    _, geometry = daytime_pass
+    camera = Camera(polarimetric_accuracy=0.005)  # one-second exposures
+    z = _residuals(geometry, camera, 200, 300, np.random.default_rng(12))
+    for name, v in z.items():
+        _standard_normal(v, name)
+    curve = synthesized_light_curve(geometry, camera, np.random.default_rng(13), exposures=200)
+    bare = synthesized_light_curve(geometry, replace(camera, polarimetric_accuracy=0.0, scintillation_correction=0.0),
+                                   np.random.default_rng(13), exposures=200)
+    assert np.all(curve.dolp_err >= 0.005) and np.median(curve.dolp_err) < 0.0051  # the floor, photon noise under it
+    assert np.median(curve.flux_err / bare.flux_err) > 3 and np.median(curve.dolp_err / bare.dolp_err) > 3
 
 
 def test_synth_pass_writes_the_curve_and_bad_input_is_one_line_with_nothing_left(tmp_path, daytime_pass):

@@ -37,6 +37,12 @@ class Camera:
     psf_fwhm_pixels: float = 2.0
     aperture_area_m2: float = 2.544  # the telescope: the paper's A_0 (Table 2)
     transmittance: float = 0.63  # optics x atmosphere: the paper's tau_0 tau_s = 0.9 x 0.7
+    # the polarimeter's calibration accuracy (1 sigma in normalized q and u each), the floor of a bright target's
+    # DoLP error: 0 an ideal polarimeter (photon noise only); "sub-percent" after a careful calibration of
+    # IMX250MZR-class sensors (Stockmans et al. 2024, JATIS), more behind a telescope's own instrumental polarization
+    polarimetric_accuracy: float = 0.0
+    # scintillation's C_Y (skylight.scintillation): 1.5 the median over sites, 0 none
+    scintillation_correction: float = 1.5
     layout: Layout = IMX250MZR
     exposure_set: bool = True  # False: ``observe`` chooses the exposure for the pass's sky (camera files without one)
 
@@ -46,7 +52,9 @@ class Camera:
                   "full_well_e": self.full_well_e > 0, "adc_bits": 1 <= self.adc_bits <= 32,
                   "exposure_s": self.exposure_s > 0, "pixel_scale_arcsec": self.pixel_scale_arcsec > 0,
                   "psf_fwhm_pixels": self.psf_fwhm_pixels > 0, "aperture_area_m2": self.aperture_area_m2 > 0,
-                  "transmittance": 0 < self.transmittance <= 1}
+                  "transmittance": 0 < self.transmittance <= 1,
+                  "polarimetric_accuracy": 0 <= self.polarimetric_accuracy < 1,
+                  "scintillation_correction": self.scintillation_correction >= 0}
         for name, ok in checks.items():
             value = getattr(self, name)
             if not (np.isfinite(value) and ok):

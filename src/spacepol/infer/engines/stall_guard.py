@@ -5,10 +5,9 @@ network says they lie inside. Where the network accepts almost nothing of the el
 posterior of a light curve; upstream: johannesulf/nautilus issues 26 and 28) that loop runs for hours, calling the
 likelihood rarely or never, so neither a call budget nor nautilus' own ``timeout`` (checked between batches) stops
 it. Two signs, each far from a healthy run: no likelihood call for ``STALL_SECONDS``, or the newest shell's bound
-keeping fewer than ``MIN_ACCEPTANCE`` of ``MIN_DRAWS`` or more points drawn (a healthy shell keeps 1-50 %). The
-watchdog thread then raises ``SamplerStalled`` in the sampling thread (``PyThreadState_SetAsyncExc``, delivered at
-the next Python instruction of the rejection loop, which is Python code). Ctrl-C is kept too: scikit-learn's network
-training swallows a KeyboardInterrupt, so the guard notes it and raises it again at the next likelihood call.
+keeping fewer than ``MIN_ACCEPTANCE`` of ``MIN_DRAWS`` or more points drawn (a healthy shell keeps 1-50 %): then
+``SamplerStalled`` is raised in the sampling thread (``PyThreadState_SetAsyncExc``). The guard also keeps Ctrl-C,
+which scikit-learn's network training would swallow (details: docs/internals.md).
 """
 
 from __future__ import annotations

@@ -157,7 +157,7 @@ def test_synthetic_errors_are_the_scatter_of_the_draws(daytime_pass):
 
 def test_a_bright_targets_errors_are_scintillation_and_the_polarimeters_calibration(daytime_pass):
     """With 200 one-second frames per time the photon noise is far below the floors: the flux's stated error is
-    scintillation's and the DoLP's the calibration accuracy (0.005 here), and (measured - true) / stated error is N(0, 1)
+    scintillation's and the DoLP's the camera's calibration accuracy (0.005), and (measured - true) / stated error is N(0, 1)
     over 300 draws (5 Monte-Carlo SEs). Control: a camera without the floors states errors several times smaller
     than that scatter. Scintillation itself agrees with Young's original formula (0.09 D_cm^-2/3 X^1.75 (2t)^-1/2 at
     sea level) to 10 % at the zenith with C_Y = 1."""
@@ -166,7 +166,7 @@ def test_a_bright_targets_errors_are_scintillation_and_the_polarimeters_calibrat
     young = 0.09 * 180.0 ** (-2 / 3) / np.sqrt(2 * 200.0)
     assert abs(scintillation_relative(1.8, 90.0, 0.0, 200.0, correction=1.0) / young - 1) < 0.1
     _, geometry = daytime_pass
-    camera = Camera(polarimetric_accuracy=0.005)  # one-second exposures
+    camera = Camera()  # one-second exposures, calibrated to 0.005
     z = _residuals(geometry, camera, 200, 300, np.random.default_rng(12))
     for name, v in z.items():
         _standard_normal(v, name)

@@ -9,6 +9,7 @@ import pytest
 
 import spacepol
 from cli_runner import run_cli
+from spacepol.camera.sensor import Camera
 from spacepol.detect.light_curve_inversion import MaterialFit
 from spacepol.detect.light_curve_model import LightCurveModel
 from spacepol.detect.materials import LIBRARY, material
@@ -68,13 +69,15 @@ def test_the_inversions_model_is_the_chain_observe_uses(tmp_path):
 @pytest.fixture(scope="module")
 def rendered(tmp_path_factory):
     """A box of solar-cell cover glass (drawn from its prior) yawed 15 deg, pitched -8, rolled 4, over the daytime
-    pass every 30 seconds: (folder, light-curve CSV, the unknown-material target, truth)."""
+    pass every 30 seconds, seen by an ideal polarimeter (the inversion's machinery under test, not an instrument's
+    calibration): (folder, light-curve CSV, the unknown-material target, truth)."""
     folder = tmp_path_factory.mktemp("render")
     truth = truth_of("solar_glass", np.random.default_rng(2)) | Attitude(15.0, -8.0, 4.0).to_json()
     attitude = Attitude(truth["yaw_deg"], truth["pitch_deg"], truth["roll_deg"])
     materials = {k: v for k, v in truth.items() if k not in attitude.to_json()}
+    ideal = Camera(exposure_set=False, polarimetric_accuracy=0.0)  # photon noise only; the exposure set for the pass
     curve = spacepol.synth_pass(TLE, SITE, START, END, target=box(folder / "true.toml", materials, attitude), step_s=30.0,
-                                seed=5, out=folder / "pass.csv")
+                                camera=ideal, seed=5, out=folder / "pass.csv")
     return folder, folder / "pass.csv", box(folder / "unknown.toml"), truth, curve
 
 

@@ -123,3 +123,18 @@ def test_the_demos_pass_writes_its_report_and_names_every_detector(tmp_path):
     assert (tmp_path / "observe" / "report.html").exists() and (tmp_path / "observe" / "light_curves.png").exists()
     over = observation.p_detect_over_pass()
     assert over["stokes"].shape == (100,) and np.all(over["stokes"] >= over["false_alarm"] - 1e-12)
+
+
+def test_an_automatic_exposure_never_outlasts_the_time_step():
+    """Under a twilight sky (the ISS over Perth, sun 10 deg down) half the well takes minutes to fill; the exposure
+    set for a pass in 20 s steps is the step itself, one a camera can take within it, and a step long enough leaves
+    the sky's own choice."""
+    from spacepol.detect.observation import exposed_for
+
+    tle = read_tle(bundled("tle", "iss_zarya_2014-01-20.tle"))
+    g = pass_geometry(tle, (-31.95, 115.86, 20.0), "2014-01-23T12:10:00Z", "2014-01-23T12:15:00Z", 20.0)
+    free = auto_exposure_s(Camera(), g)
+    assert free > 100.0, free  # the sky alone would ask for minutes
+    assert exposed_for(Camera(exposure_set=False), g, 5.40, 20.0).exposure_s == 20.0
+    assert exposed_for(Camera(exposure_set=False), g, 5.40, 10 * free).exposure_s == free
+    assert exposed_for(Camera(exposure_s=300.0), g, 5.40, 20.0).exposure_s == 300.0  # the user's own is kept

@@ -98,15 +98,24 @@ def test_ctrl_c_swallowed_inside_the_sampler_is_raised_again_at_the_next_likelih
             return True
         return False
 
-    clock = CallClock()
-    with pytest.raises(KeyboardInterrupt):
+    original = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in an interactive shell
+    try:
+        clock = CallClock()
+        with pytest.raises(KeyboardInterrupt):
+            with stall_guard(clock, "material kapton", seconds=30.0, poll_seconds=0.05):
+                assert swallowed_interrupt()
+                clock.tick()
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # put back as it was
+        # the control: without the guard, the swallowed interrupt is lost and the next call goes on
+        clock = CallClock()
+        assert swallowed_interrupt()
+        clock.tick()
+        assert clock.calls == 1
+        # Ctrl-C ignored (a run under nohup) stays ignored inside the guard
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         with stall_guard(clock, "material kapton", seconds=30.0, poll_seconds=0.05):
-            assert swallowed_interrupt()
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+            assert not swallowed_interrupt()
             clock.tick()
-    handler = signal.getsignal(signal.SIGINT)
-    assert handler is signal.default_int_handler, handler  # put back as it was
-    # the control: without the guard, the swallowed interrupt is lost and the next call goes on
-    clock = CallClock()
-    assert swallowed_interrupt()
-    clock.tick()
-    assert clock.calls == 1
+    finally:
+        signal.signal(signal.SIGINT, original)

@@ -48,7 +48,7 @@ def synth_pass(tle, site, start, end, *, target, step_s: float = 10.0, satellite
         fixed_material(face.material)
     cam = camera_given(camera)
     geometry = pass_geometry(read_tle(tle, satellite), site, start, end, step_s, faces)
-    cam = exposed_for(cam, geometry, sky_magnitude_zenith)
+    cam = exposed_for(cam, geometry, sky_magnitude_zenith, step_s)
     frames = exposures_per_step or max(1, int(step_s // cam.exposure_s))
     curve = synthesized_light_curve(geometry, cam, np.random.default_rng(seed), band_um, sky_magnitude_zenith, frames)
     if out is not None:

@@ -38,9 +38,9 @@ class Camera:
     aperture_area_m2: float = 2.544  # the telescope: the paper's A_0 (Table 2)
     transmittance: float = 0.63  # optics x atmosphere: the paper's tau_0 tau_s = 0.9 x 0.7
     # the polarimeter's calibration accuracy (1 sigma in normalized q and u each), the floor of a bright target's
-    # DoLP error: 0 an ideal polarimeter (photon noise only); "sub-percent" after a careful calibration of
-    # IMX250MZR-class sensors (Stockmans et al. 2024, JATIS), more behind a telescope's own instrumental polarization
-    polarimetric_accuracy: float = 0.0
+    # DoLP error: "sub-percent" after a careful calibration of IMX250MZR-class sensors (Stockmans et al. 2024,
+    # JATIS), more behind a telescope's own instrumental polarization; 0 an ideal polarimeter (photon noise only)
+    polarimetric_accuracy: float = 0.005
     # scintillation's C_Y (skylight.scintillation): 1.5 the median over sites, 0 none
     scintillation_correction: float = 1.5
     layout: Layout = IMX250MZR

@@ -179,14 +179,16 @@ def sky_photons_at(geometry, sky_magnitude_zenith: float = 5.40) -> np.ndarray:
     return background_photon_flux(sky_magnitude_zenith) * relative * (geometry.sun_elevation_deg > -0.833)
 
 
-def auto_exposure_s(camera, geometry, sky_magnitude_zenith: float = 5.40, fill: float = 0.5) -> float:
+def auto_exposure_s(camera, geometry, sky_magnitude_zenith: float = 5.40, fill: float = 0.5,
+                    longest_s: float = np.inf) -> float:
     """The exposure an observer would set: the brightest sky the target is seen against (above the horizon) fills
-    ``fill`` of the full well, rounded down to 1, 2 or 5 x 10^k s."""
+    ``fill`` of the full well, at most ``longest_s`` (a time step: a frame cannot outlast it; a dark twilight sky
+    would ask for minutes), rounded down to 1, 2 or 5 x 10^k s."""
     above = geometry.elevation_deg > 0
     sky = sky_photons_at(geometry, sky_magnitude_zenith)[above] if above.any() else np.zeros(1)
     rate = camera.quantum_efficiency * camera.transmittance * camera.aperture_area_m2 * camera.pixel_scale_arcsec**2 \
         * 0.5 * camera.transmissions[0] * float(np.max(sky)) + camera.dark_current_e_per_s
-    seconds = fill * camera.full_well_e / rate
+    seconds = min(fill * camera.full_well_e / rate, longest_s)
     decade = 10.0 ** np.floor(np.log10(seconds))
     return float(max(step * decade for step in (1.0, 2.0, 5.0) if step * decade <= seconds))
 
@@ -203,14 +205,15 @@ def camera_given(camera):
     return camera_from_toml(camera) if isinstance(camera, (str, Path)) else camera
 
 
-def exposed_for(camera, geometry, sky_magnitude_zenith: float):
+def exposed_for(camera, geometry, sky_magnitude_zenith: float, step_s: float = np.inf):
     """``camera`` as it is where its exposure was given; else with the exposure that keeps the brightest sky of the
-    pass at half the well (``auto_exposure_s``)."""
+    pass at half the well, no longer than a time step ``step_s`` (``auto_exposure_s``)."""
     from dataclasses import replace
 
     if camera.exposure_set:
         return camera
-    return replace(camera, exposure_s=auto_exposure_s(camera, geometry, sky_magnitude_zenith), exposure_set=True)
+    seconds = auto_exposure_s(camera, geometry, sky_magnitude_zenith, longest_s=step_s)
+    return replace(camera, exposure_s=seconds, exposure_set=True)
 
 
 def _sky_aop(geometry) -> np.ndarray:
@@ -246,7 +249,7 @@ def observe_result(result, tle, site: tuple[float, float, float], start, end, *,
             fixed_material(face.material)
     element_set = read_tle(tle, satellite)
     geometry = pass_geometry(element_set, site, start, end, step_s, faces)
-    camera = exposed_for(camera, geometry, sky_magnitude_zenith)
+    camera = exposed_for(camera, geometry, sky_magnitude_zenith, step_s)
     scenario = default_scenario()
     scenario.instrument.update(band_low_um=float(band_um[0]), band_high_um=float(band_um[1]))
     inner, params, material = material_samples(result.model, result.samples(), scenario,

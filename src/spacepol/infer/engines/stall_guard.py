@@ -47,8 +47,10 @@ class CallClock:
 def _interrupts_kept(clock: CallClock):
     """Within the block, Ctrl-C raises KeyboardInterrupt as usual and also marks ``clock``, whose next ``tick``
     raises it again: code that catches and drops the first (scikit-learn's MLP training, inside nautilus) cannot
-    swallow it. Outside the main thread, where signals cannot be handled, the block runs as it is."""
-    if threading.current_thread() is not threading.main_thread():
+    swallow it. Where Ctrl-C does not raise KeyboardInterrupt already (ignored, as under nohup, or handled by the
+    caller) or outside the main thread, where signals cannot be handled, the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         yield
         return
 

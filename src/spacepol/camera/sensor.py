@@ -17,6 +17,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..errors import ParameterError
+from ..skylight.scintillation import MEDIAN_CORRECTION
 from .mosaic import IMX250MZR, Layout
 
 
@@ -42,7 +43,7 @@ class Camera:
     # JATIS), more behind a telescope's own instrumental polarization; 0 an ideal polarimeter (photon noise only)
     polarimetric_accuracy: float = 0.005
     # scintillation's C_Y (skylight.scintillation): 1.5 the median over sites, 0 none
-    scintillation_correction: float = 1.5
+    scintillation_correction: float = MEDIAN_CORRECTION
     layout: Layout = IMX250MZR
     exposure_set: bool = True  # False: ``observe`` chooses the exposure for the pass's sky (camera files without one)
 

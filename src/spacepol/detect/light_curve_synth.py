@@ -51,7 +51,7 @@ def synthesized_light_curve(geometry, camera, rng: np.random.Generator, band_um=
     var1, var2 = (variance[0] + variance[2]) / (4 * k * k), (variance[1] + variance[3]) / (4 * k * k)
     # the polarimeter's calibration error, in normalized q and u alike
     accuracy = camera.polarimetric_accuracy
-    q, u = (np.stack([s1, s2]) / s0 + accuracy * rng.standard_normal((2, s0.size)))
+    q, u = np.stack([s1, s2]) / s0 + accuracy * rng.standard_normal((2, s0.size))
     s1, s2 = q * s0, u * s0
     linear = np.hypot(s1, s2)
     safe_linear = np.maximum(linear, 1e-300)
@@ -59,7 +59,7 @@ def synthesized_light_curve(geometry, camera, rng: np.random.Generator, band_um=
     var_linear = (s1**2 * var1 + s2**2 * var2) / safe_linear**2
     dolp_err = np.sqrt(var_linear / s0**2 + linear**2 * var0 / s0**4 + accuracy**2)
     aop_err = np.degrees(0.5 * np.sqrt((s2**2 * var1 + s1**2 * var2) / safe_linear**4 + accuracy**2 / np.maximum(dolp**2, 1e-300)))
-    flux_err = np.sqrt(var0 + (twinkle * mean.sum(axis=0) / (4 * k)) ** 2)
+    flux_err = np.sqrt(var0 + (twinkle * stokes[0]) ** 2)  # scintillation of the true flux, as photon noise is
     times = [t for t, on in zip(geometry.times_utc, keep) if on]
     return LightCurve(times, flux=s0[keep], flux_err=flux_err[keep], dolp=dolp[keep], dolp_err=dolp_err[keep],
                       aop_deg=0.5 * np.degrees(np.arctan2(s2, s1))[keep], aop_err_deg=aop_err[keep],

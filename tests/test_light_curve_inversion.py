@@ -124,7 +124,7 @@ def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_rea
     assert MaterialFit.load(folder / "fit" / "fits" / "aluminium.npz", "any") is None  # none saved: fitted
     # a candidate whose sampler ran out of its budget short of the draws is named in the verdict; the run's are not
     report = (folder / "fit" / "report.html").read_text()
-    assert "Few effective draws" not in report and "restart" not in report and "second attitude" not in report
+    assert "Few effective draws" not in report and "restart" not in report and "the exploration missed" not in report
     assert "ended where it stood" not in report
     rough = replace(inversion, fits=[replace(f, effective_draws=3.0) if f.material == "kapton" else f for f in inversion.fits])
     assert "Few effective draws (under 200) for kapton (3)" in verdict_text(rough.to_json())

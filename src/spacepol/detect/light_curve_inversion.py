@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import ParameterError, SamplerStalled
 from ..infer.diagnostics import loo
 from ..orbit.attitude import ANGLES
-from .attitude_modes import attitude_words
+from .attitude_modes import MARGIN, attitude_words
 from .light_curve_likelihood import pointwise, replicates
 from .light_curve_model import LightCurveModel
 from .target import linear_polarization
@@ -149,8 +149,9 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     added = None
     if missed is not None:
         if progress:
-            print(f"  {name}: a second attitude ({attitude_words(missed.attitude)} deg) outside every draw fits about "
-                  "as well; sampling it on its own", file=sys.stderr)
+            print(f"  {name}: an attitude ({attitude_words(missed.attitude)} deg) outside every draw fits "
+                  f"{'far better' if missed.below_best < -MARGIN else 'about as well'}; sampling it on its own",
+                  file=sys.stderr)
         box = _mode_box(model, missed.attitude)
         second = _nested(model, log_likelihood, _rescaling(model, box), live, rng, clock,
                          f"material {name}, its second attitude")
@@ -260,7 +261,7 @@ def _joined(model: LightCurveModel, first: _Run, second: _Run, box: np.ndarray, 
     log_z = float(logsumexp(log_mass))
     share = float(np.exp(logsumexp(second_mass) - log_z))
     added = {"attitude": mode.attitude, "share": share, "log_posterior": mode.log_posterior,
-             "finding": f"a second attitude ({attitude_words(mode.attitude)} deg) the exploration missed was sampled on "
+             "finding": f"an attitude ({attitude_words(mode.attitude)} deg) the exploration missed was sampled on "
                         f"its own and holds {100 * share:.0f} % of the posterior"}
     joined = _Run(np.concatenate([first.points[~inside], second.points]), log_mass, log_z,
                   first.calls + second.calls, first.restarts + second.restarts,
@@ -272,7 +273,7 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
                         draws_log_posterior: np.ndarray, rng: np.random.Generator):
     """``attitude_modes.unsampled_mode`` of a fit's draws (an ``AttitudeMode``; None where the draws miss none or the
     attitude is known)."""
-    from .attitude_modes import unsampled_mode
+    from .attitude_modes import MATERIAL_DRAWS, unsampled_mode
 
     if model.attitude is not None:
         return None
@@ -280,8 +281,9 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
     def log_posterior(theta):
         return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
 
+    prior_draws = _rescaling(model)(rng.random((MATERIAL_DRAWS, model.ndim)))
     return unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws,
-                          draws_log_posterior, rng)
+                          draws_log_posterior, prior_draws)
 
 
 def _bands(model: LightCurveModel, curve, draws: np.ndarray, rng: np.random.Generator) -> dict:

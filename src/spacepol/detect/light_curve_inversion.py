@@ -281,7 +281,8 @@ def _unsampled_attitude(model: LightCurveModel, curve, observables: list[str], d
     def log_posterior(theta):
         return pointwise_log_likelihood(model, curve, observables, theta).sum(axis=1) + model.log_prior(theta)
 
-    prior_draws = _rescaling(model)(rng.random((MATERIAL_DRAWS, model.ndim)))
+    own = np.random.default_rng(rng.integers(2**63))  # one draw of the run's stream, however much the check uses
+    prior_draws = _rescaling(model)(own.random((MATERIAL_DRAWS, model.ndim)))
     return unsampled_mode(log_posterior, list(model.names), [p.bounds for p in model.priors], draws,
                           draws_log_posterior, prior_draws)
 

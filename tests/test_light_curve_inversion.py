@@ -75,7 +75,7 @@ def rendered(tmp_path_factory):
     truth = truth_of("solar_glass", np.random.default_rng(2)) | Attitude(15.0, -8.0, 4.0).to_json()
     attitude = Attitude(truth["yaw_deg"], truth["pitch_deg"], truth["roll_deg"])
     materials = {k: v for k, v in truth.items() if k not in attitude.to_json()}
-    ideal = Camera(exposure_set=False, polarimetric_accuracy=0.0)  # photon noise only; the exposure set for the pass
+    ideal = Camera(exposure_set=False, polarimetric_accuracy=0.0, scintillation_correction=0.0)  # photon noise only
     curve = spacepol.synth_pass(TLE, SITE, START, END, target=box(folder / "true.toml", materials, attitude), step_s=30.0,
                                 camera=ideal, seed=5, out=folder / "pass.csv")
     return folder, folder / "pass.csv", box(folder / "unknown.toml"), truth, curve

@@ -121,8 +121,8 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
                  progress: bool = False) -> MaterialFit:
     """``model``'s posterior given ``curve``'s ``observables`` and its evidence ln Z: nested sampling (nautilus,
     ``live`` live points, the likelihood in blocks), whose shells cover the whole prior and so every mode it resolves.
-    Where the draws miss the mirrored attitude's mode (``attitude_modes``), a second run samples the angles within
-    ``BOX_DEG`` of it, and the two are joined over that partition of the prior (``_joined``)."""
+    Where the draws miss an attitude mode (``attitude_modes``: a search of the whole prior), a second run samples the
+    angles within ``BOX_DEG`` of it, and the two are joined over that partition of the prior (``_joined``)."""
     from ..infer.engines.nested import kish_draws
     from ..infer.engines.stall_guard import CallClock
 

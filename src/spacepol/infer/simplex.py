@@ -14,8 +14,9 @@ import numpy as np
 def maximize_from(f, starts: np.ndarray, scale: np.ndarray, bounds: np.ndarray, max_steps: int = 3000,
                   relative_tolerance: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
     """The local maxima of ``f`` reached from each row of ``starts`` (K, D): (K, D) points and their (K,) values.
-    Each start's first simplex spans ``scale`` ((D,) or one row per start, (K, D)) along the axes; a simplex stops when its values agree within
-    ``relative_tolerance`` (relative to the best, plus one) or after ``max_steps`` steps. ``bounds``: (D, 2)."""
+    Each start's first simplex spans ``scale`` ((D,) or one row per start, (K, D)) along the axes; a simplex stops
+    when its values agree within ``relative_tolerance`` (relative to the best, plus one) or after ``max_steps``
+    steps. ``bounds``: (D, 2)."""
     starts = np.atleast_2d(np.asarray(starts, float))
     count, dim = starts.shape
     lower, upper = np.asarray(bounds, float).T
@@ -33,7 +34,8 @@ def maximize_from(f, starts: np.ndarray, scale: np.ndarray, bounds: np.ndarray, 
         simplex = np.take_along_axis(simplex, order[:, :, None], axis=1)
         costs = np.take_along_axis(costs, order, axis=1)
         spread = costs[:, -1] - costs[:, 0]
-        moving = np.flatnonzero(~(spread <= relative_tolerance * (1.0 + np.abs(costs[:, 0]))) & np.isfinite(costs[:, 0]))
+        settled = spread <= relative_tolerance * (1.0 + np.abs(costs[:, 0]))
+        moving = np.flatnonzero(~settled & np.isfinite(costs[:, 0]))
         if not len(moving):
             break
         _step(simplex, costs, moving, cost, lower, upper)

@@ -12,7 +12,7 @@ above it, more than ``SEPARATED`` of the draws' own SD from each draw in some an
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -45,6 +45,11 @@ class AttitudeMode:
     log_posterior: float
     below_best: float
     finding: str
+
+    @property
+    def far_better(self) -> bool:
+        """Above the best draw by more than ``MARGIN``: the draws hold a lesser optimum, not one of two."""
+        return self.below_best < -MARGIN
 
     def to_json(self) -> dict:
         """The record lightcurve.json carries."""
@@ -84,7 +89,8 @@ def unsampled_mode(log_posterior, names: list[str], bounds, draws: np.ndarray, d
     attitude = {names[j]: float(theta[j]) for j in columns}
     at = attitude_words(attitude)
     drawn = attitude_words({names[j]: best[j] for j in columns})
-    if value > best_value + MARGIN:
+    mode = AttitudeMode(attitude, theta, value, best_value - value, "")
+    if mode.far_better:
         finding = (f"an attitude ({at} deg) fits far better than the best draw ({drawn} deg; log posterior "
                    f"{value - best_value:+.1f}) and lies outside every draw: the exploration kept a lesser optimum, so "
                    "the attitude's intervals exclude the posterior's main mode")
@@ -93,7 +99,7 @@ def unsampled_mode(log_posterior, names: list[str], bounds, draws: np.ndarray, d
                    f"best draw ({drawn} deg; log posterior {value - best_value:+.1f}) and lies outside every draw: the "
                    "draws hold one of two attitudes only, so the attitude's intervals may exclude the truth (more "
                    "--live points sample both)")
-    return AttitudeMode(attitude, theta, value, best_value - value, finding)
+    return replace(mode, finding=finding)
 
 
 def _grid_leaders(log_posterior, bounds: np.ndarray, columns: list[int], prior_draws: np.ndarray) -> np.ndarray:

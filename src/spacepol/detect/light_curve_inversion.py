@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import ParameterError, SamplerStalled
 from ..infer.diagnostics import loo
 from ..orbit.attitude import ANGLES
-from .attitude_modes import MARGIN, attitude_words
+from .attitude_modes import attitude_words
 from .light_curve_likelihood import pointwise, replicates
 from .light_curve_model import LightCurveModel
 from .target import linear_polarization
@@ -150,7 +150,7 @@ def fit_material(model: LightCurveModel, curve, observables: list[str], rng: np.
     if missed is not None:
         if progress:
             print(f"  {name}: an attitude ({attitude_words(missed.attitude)} deg) outside every draw fits "
-                  f"{'far better' if missed.below_best < -MARGIN else 'about as well'}; sampling it on its own",
+                  f"{'far better' if missed.far_better else 'about as well'}; sampling it on its own",
                   file=sys.stderr)
         box = _mode_box(model, missed.attitude)
         second = _nested(model, log_likelihood, _rescaling(model, box), live, rng, clock,

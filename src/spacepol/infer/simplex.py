@@ -21,8 +21,8 @@ def maximize_from(f, starts: np.ndarray, scale: np.ndarray, bounds: np.ndarray, 
     count, dim = starts.shape
     lower, upper = np.asarray(bounds, float).T
 
-    def cost(rows):  # minimised; non-finite values rank last
-        value = -np.asarray(f(np.clip(rows, lower, upper)), float)
+    def cost(rows):  # minimised; non-finite values rank last. Every point is clipped to the bounds before it is costed
+        value = -np.asarray(f(rows), float)
         return np.where(np.isfinite(value), value, np.inf)
 
     simplex = np.repeat(starts[:, None, :], dim + 1, axis=1)
@@ -41,7 +41,7 @@ def maximize_from(f, starts: np.ndarray, scale: np.ndarray, bounds: np.ndarray, 
         _step(simplex, costs, moving, cost, lower, upper)
     best = np.argmin(costs, axis=1)
     rows = np.arange(count)
-    return np.clip(simplex[rows, best], lower, upper), -costs[rows, best]
+    return simplex[rows, best], -costs[rows, best]
 
 
 def _step(simplex, costs, moving, cost, lower, upper) -> None:

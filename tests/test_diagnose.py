@@ -309,22 +309,23 @@ def test_worker_processes_end_when_diagnose_is_killed(tmp_path):
     script = tmp_path / "pool.py"
     script.write_text(_POOL_SCRIPT)
 
-    def orphans(kind: str, wait_s: float) -> list[int]:
-        parent = subprocess.Popen([sys.executable, str(script), kind], stdout=subprocess.PIPE, text=True)
-        workers = [int(p) for p in parent.stdout.readline().split()]
-        assert len(workers) == 2, workers
-        time.sleep(0.5)  # the workers are in their two-minute tasks
+    # the three pools at once: the control's five seconds pass while the watched workers end
+    parents = {kind: subprocess.Popen([sys.executable, str(script), kind], stdout=subprocess.PIPE, text=True)
+               for kind in ("fits", "spawned", "plain")}
+    workers = {kind: [int(p) for p in parent.stdout.readline().split()] for kind, parent in parents.items()}
+    assert all(len(pids) == 2 for pids in workers.values()), workers
+    time.sleep(0.5)  # the workers are in their two-minute tasks
+    for parent in parents.values():
         parent.send_signal(signal.SIGKILL)
         parent.wait()
-        deadline = time.monotonic() + wait_s
-        while time.monotonic() < deadline and any(_alive(p) for p in workers):
-            time.sleep(0.2)
-        return [p for p in workers if _alive(p)]
-
-    assert orphans("fits", 15.0) == []  # the watchdog looks once a second
-    assert orphans("spawned", 15.0) == []
-    left = orphans("plain", 5.0)
+    killed = time.monotonic()
+    watched = workers["fits"] + workers["spawned"]
+    while time.monotonic() < killed + 15.0 and any(_alive(p) for p in watched):  # the watchdog looks once a second
+        time.sleep(0.2)
+    time.sleep(max(0.0, killed + 5.0 - time.monotonic()))
+    left = [p for p in workers["plain"] if _alive(p)]
     try:
+        assert [p for p in watched if _alive(p)] == []
         assert left, "the control's workers ended with their parent: the test cannot see the difference"
     finally:
         for pid in left:

@@ -65,22 +65,29 @@ print(json.dumps({"before": before, "after_import": after_import, "after_call": 
 """
 
 
-def _settings(call: str) -> dict:
+def _settings(*calls: str) -> list[dict]:
+    """Per call (``spacepol``'s function, or "none"), the settings before and after the import and after the call,
+    each in a fresh process; the processes run at once."""
     import json
 
     env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS",
                                                           "XLA_FLAGS", "JAX_ENABLE_X64", "SPACEPOL_CACHE_DIR")}
-    out = subprocess.run([sys.executable, "-c", SETTINGS, call], env=env, capture_output=True, text=True, check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    procs = [subprocess.Popen([sys.executable, "-c", SETTINGS, call], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for call in calls]
+    found = []
+    for proc in procs:
+        out, err = proc.communicate()
+        assert proc.returncode == 0, err
+        found.append(json.loads(out.strip().splitlines()[-1]))
+    return found
 
 
 def test_importing_spacepol_changes_no_process_wide_setting():
     """Neither ``import spacepol`` nor importing its inference and criticism layers changes BLAS threads, the
     environment (BLAS, XLA and malloc variables) or a JAX flag. Control: ``configure_process()`` does change them, so
     the check can see a change."""
-    quiet = _settings("none")
+    quiet, opted = _settings("none", "configure_process")  # two processes at once
     assert quiet["after_import"] == quiet["before"], (quiet["before"], quiet["after_import"])
-    opted = _settings("configure_process")
     assert opted["after_import"] == opted["before"]
     changed = {k for k in opted["before"] if opted["after_call"][k] != opted["before"][k]}
     assert {"jax", "env"} <= changed, changed

@@ -66,33 +66,50 @@ def test_the_inversions_model_is_the_chain_observe_uses(tmp_path):
     assert np.abs(alone[:, 0] - alone[:, 1]).max() > 1e-3 * np.abs(alone).max()  # control: the sets differ
 
 
-@pytest.fixture(scope="module")
-def rendered(tmp_path_factory):
+def _rendered(tmp_path_factory, step_s: float):
     """A box of solar-cell cover glass (drawn from its prior) yawed 15 deg, pitched -8, rolled 4, over the daytime
-    pass every 30 seconds, seen by an ideal polarimeter (the inversion's machinery under test, not an instrument's
-    calibration): (folder, light-curve CSV, the unknown-material target, truth)."""
+    pass every ``step_s`` seconds, seen by an ideal polarimeter (the inversion's machinery under test, not an
+    instrument's calibration): (folder, light-curve CSV, the unknown-material target, truth, the curve)."""
     folder = tmp_path_factory.mktemp("render")
     truth = truth_of("solar_glass", np.random.default_rng(2)) | Attitude(15.0, -8.0, 4.0).to_json()
     attitude = Attitude(truth["yaw_deg"], truth["pitch_deg"], truth["roll_deg"])
     materials = {k: v for k, v in truth.items() if k not in attitude.to_json()}
     ideal = Camera(exposure_set=False, polarimetric_accuracy=0.0, scintillation_correction=0.0)  # photon noise only
-    curve = spacepol.synth_pass(TLE, SITE, START, END, target=box(folder / "true.toml", materials, attitude), step_s=30.0,
+    curve = spacepol.synth_pass(TLE, SITE, START, END, target=box(folder / "true.toml", materials, attitude), step_s=step_s,
                                 camera=ideal, seed=5, out=folder / "pass.csv")
     return folder, folder / "pass.csv", box(folder / "unknown.toml"), truth, curve
 
 
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """The render every 30 seconds (19 times)."""
+    return _rendered(tmp_path_factory, 30.0)
+
+
+@pytest.fixture(scope="module")
+def rendered_every_10_s(tmp_path_factory):
+    """The render every 10 seconds: the glints that tell the materials apart then span several times each."""
+    return _rendered(tmp_path_factory, 10.0)
+
+
 @pytest.mark.slow
-def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered):
+def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered_every_10_s):
     """Candidates solar_glass (true) and aluminium, the attitude unknown: the true one first by more than 2 SE of the
-    paired difference and by ln Z; each attitude offset's 90 % interval holds the truth and is narrower than 30 deg."""
-    folder, csv, unknown, truth, _ = rendered
+    paired difference and by ln Z; each attitude offset's 90 % interval is narrower than 30 deg, and the truth lies
+    within each offset's central 99 % (three 90 % intervals of a calibrated posterior all hold in only 73 % of renders;
+    their coverage over renders is ``benchmarks/light_curve_calibration.py``'s). Every 10 s, not 30: sampled every
+    30 s, two glint points carried half of the difference (2.1 SE). Measured: 3.7 SE; the truth at the 64th, 63rd and
+    60th percentiles of yaw, pitch and roll (renders of seeds 6 and 7: 3.7 and 3.7 SE)."""
+    folder, csv, unknown, truth, _ = rendered_every_10_s
     inversion = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, target=unknown, materials="aluminium,solar_glass",
                                            live=200, seed=1)
     first, second = inversion.ranking
     assert first["material"] == "solar_glass", inversion.ranking
     assert -second["delta_elpd"] > 2 * second["delta_elpd_se"] and second["delta_log_evidence"] < -10, second
+    best = inversion.best
     for name, q in inversion.to_json()["attitude"].items():
-        assert q["q05"] <= truth[name] <= q["q95"] and q["q95"] - q["q05"] < 30.0, (name, q, truth[name])
+        low, high = np.percentile(best.samples[:, best.names.index(name)], [0.5, 99.5])
+        assert low <= truth[name] <= high and q["q95"] - q["q05"] < 30.0, (name, low, high, q, truth[name])
 
 
 def test_with_the_attitude_known_the_hidden_material_ranks_first_and_a_rerun_reads_the_fits(rendered):

@@ -96,10 +96,10 @@ def rendered_every_10_s(tmp_path_factory):
 def test_the_hidden_material_ranks_first_and_the_attitude_is_recovered(rendered_every_10_s):
     """Candidates solar_glass (true) and aluminium, the attitude unknown: the true one first by more than 2 SE of the
     paired difference and by ln Z; each attitude offset's 90 % interval is narrower than 30 deg, and the truth lies
-    within each offset's central 99 % (three 90 % intervals of a calibrated posterior all hold in only 73 % of renders;
-    their coverage over renders is ``benchmarks/light_curve_calibration.py``'s). Every 10 s, not 30: sampled every
-    30 s, two glint points carried half of the difference (2.1 SE). Measured: 3.7 SE; the truth at the 64th, 63rd and
-    60th percentiles of yaw, pitch and roll (renders of seeds 6 and 7: 3.7 and 3.7 SE)."""
+    within each offset's central 99 % (three 90 % intervals of a calibrated posterior all hold in only 73 % of
+    renders; their coverage over renders is ``benchmarks/light_curve_calibration.py``'s). A curve every 10 seconds,
+    not 30: every 30 seconds, two glint points carried half of the difference (2.1 SE). Measured: 3.7 SE; the truth
+    at the 64th, 63rd and 60th percentiles of yaw, pitch and roll (renders of seeds 6 and 7: 3.7 and 3.7 SE)."""
     folder, csv, unknown, truth, _ = rendered_every_10_s
     inversion = spacepol.invert_lightcurve(csv, TLE, SITE, START, END, target=unknown, materials="aluminium,solar_glass",
                                            live=200, seed=1)

@@ -63,32 +63,32 @@ def summary(ranks: np.ndarray) -> list[str]:
     their binomial 90 % ranges and the ranks' KS p against uniform; the angles' rank correlations; the pooled
     coverage and the ranks of all angles in five bins."""
     n = len(ranks)
+    levels = (0.5, 0.9)
+    held = {level: np.abs(ranks - 0.5) <= level / 2 for level in levels}  # (renders, angles) per central interval
     lines = []
     for j, angle in enumerate(ANGLES):
         parts = []
-        for level in (0.5, 0.9):
-            inside = int(np.sum(np.abs(ranks[:, j] - 0.5) <= level / 2))
+        for level in levels:
             low, high = stats.binom.ppf([0.05, 0.95], n, level)
-            parts.append(f"{level:.0%} intervals {inside}/{n} (binomial 90 % range {low:.0f}-{high:.0f})")
+            parts.append(f"{level:.0%} intervals {int(held[level][:, j].sum())}/{n} (binomial 90 % range "
+                         f"{low:.0f}-{high:.0f})")
         ks = stats.kstest(ranks[:, j], "uniform").pvalue
         lines.append(f"{angle}: {', '.join(parts)}; ranks' KS p = {ks:.2f}")
-    rho = stats.spearmanr(ranks).correlation if n > 2 else np.full((3, 3), np.nan)
+    rho = stats.spearmanr(ranks).correlation if n > 2 else np.full((len(ANGLES),) * 2, np.nan)
     pairs = [(0, 1), (0, 2), (1, 2)]
     lines.append("ranks' Spearman correlation over renders: " + ", ".join(
         f"{ANGLES[a][:-4]}-{ANGLES[b][:-4]} {rho[a, b]:+.2f}" for a, b in pairs)
         + " (the angles of one render are not independent where these are far from 0)")
     r = ranks.ravel()
-    for level in (0.5, 0.9):
-        held = np.abs(ranks - 0.5) <= level / 2
-        inside = int(held.sum())
+    for level in levels:
         low, high = stats.binom.ppf([0.05, 0.95], r.size, level)
         # renders as clusters: the per-render counts' own variance over the binomial one (the design effect) widens
         # the pooled count's spread about its expectation (normal approximation)
-        per_render = held.sum(axis=1)
+        per_render = held[level].sum(axis=1)
         effect = max(1.0, float(per_render.var(ddof=1)) / (ranks.shape[1] * level * (1 - level))) if n > 1 else 1.0
         spread = 1.645 * np.sqrt(effect * r.size * level * (1 - level))
-        lines.append(f"all angles pooled, {level:.0%} intervals: {inside}/{r.size} (binomial range for independent "
-                     f"intervals {low:.0f}-{high:.0f}; with the renders' design effect {effect:.2f}: "
+        lines.append(f"all angles pooled, {level:.0%} intervals: {int(per_render.sum())}/{r.size} (binomial range for "
+                     f"independent intervals {low:.0f}-{high:.0f}; with the renders' design effect {effect:.2f}: "
                      f"{level * r.size - spread:.0f}-{level * r.size + spread:.0f})")
     counts = np.histogram(r, bins=5, range=(0, 1))[0]
     lines.append(f"all ranks in five bins: {counts.tolist()}; chi-square p = {stats.chisquare(counts).pvalue:.3f} "
